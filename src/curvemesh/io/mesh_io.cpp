@@ -1,0 +1,1 @@
+#include "curvemesh/io/mesh_io.hpp"

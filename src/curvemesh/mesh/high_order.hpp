@@ -1,0 +1,92 @@
+#pragma once
+// Storage of high-order (Lagrange) nodes per mesh edge and per mesh face, and
+// the node order of order-p elements inside curvemesh.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+#include "curvemesh/core/types.hpp"
+
+namespace cm::mesh {
+
+inline constexpr int kMaxOrder = 3;
+
+/// Barycentric multi-indices (i0,i1,i2,i3), i0+..+i3 = p, of the nodes of an
+/// order-p Lagrange tet in curvemesh's internal order: the 4 vertices; then for
+/// each edge e in kTetEdges order its p-1 nodes from kTetEdges[e][0] to
+/// kTetEdges[e][1]; then for each face f in kFaceVerts order its interior nodes
+/// (ordered as tri_node_indices orders a triangle's interior nodes, relative to
+/// the face's vertex list); then the interior nodes. Index k of the multi-index
+/// is the weight of local vertex k. Size (p+1)(p+2)(p+3)/6.
+std::vector<std::array<int, 4>> tet_node_indices(int p);
+
+/// Same for a triangle: 3 vertices, edges (0,1),(1,2),(2,0) each from first to
+/// second vertex, then interior nodes in decreasing lexicographic order of
+/// (i0, i1). Size (p+1)(p+2)/2.
+std::vector<std::array<int, 3>> tri_node_indices(int p);
+
+/// High-order nodes keyed by the vertex ids of the edge / face they belong to.
+/// Edges and faces without stored nodes are straight (nodes interpolated
+/// linearly). Order 1 means a linear mesh (nothing stored).
+class HighOrderNodes {
+ public:
+  int order() const { return order_; }
+  /// Clears all nodes and sets the order (1..kMaxOrder; throws otherwise).
+  void reset(int order);
+
+  /// Stores the p-1 nodes of edge (a,b), listed from a to b.
+  void set_edge(VertId a, VertId b, std::span<const Vec3> nodes_from_a);
+  /// Writes the p-1 nodes from a to b into out; false if the edge has none.
+  bool get_edge(VertId a, VertId b, Vec3* out_from_a) const;
+
+  /// Stores the interior nodes of triangle (a,b,c), ordered as the interior
+  /// entries of tri_node_indices(p) relative to (a,b,c).
+  void set_face(VertId a, VertId b, VertId c, std::span<const Vec3> nodes);
+  bool get_face(VertId a, VertId b, VertId c, Vec3* out) const;
+
+  std::size_t num_edges() const { return edge_slot_.size(); }
+  std::size_t num_faces() const { return face_slot_.size(); }
+  std::size_t nodes_per_edge() const { return order_ > 1 ? order_ - 1 : 0; }
+  std::size_t nodes_per_face() const {
+    return order_ > 2 ? static_cast<std::size_t>((order_ - 1) * (order_ - 2) / 2) : 0;
+  }
+
+  /// Calls fn(a, b, nodes_from_a) for every stored edge (a < b).
+  template <class Fn>
+  void for_each_edge(Fn&& fn) const {
+    for (const auto& [key, slot] : edge_slot_)
+      fn(static_cast<VertId>(key >> 32), static_cast<VertId>(key & 0xffffffffu),
+         std::span<const Vec3>(edge_nodes_.data() + slot * nodes_per_edge(), nodes_per_edge()));
+  }
+
+ private:
+  struct FaceKey {
+    VertId v[3];
+    friend bool operator==(const FaceKey&, const FaceKey&) = default;
+  };
+  struct FaceKeyHash {
+    std::size_t operator()(const FaceKey& k) const;
+  };
+  int order_ = 1;
+  std::unordered_map<std::uint64_t, std::uint32_t> edge_slot_;
+  std::vector<Vec3> edge_nodes_;
+  std::unordered_map<FaceKey, std::uint32_t, FaceKeyHash> face_slot_;
+  std::vector<Vec3> face_nodes_;
+};
+
+struct TetMesh;
+
+/// All nodes of tet t in the internal order of tet_node_indices(order): stored
+/// edge/face nodes where present, linear interpolation elsewhere.
+std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t);
+/// All nodes of triangle (a,b,c) in the order of tri_node_indices(order).
+std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri);
+
+/// Stores, from the full node list of tet t (internal order), the edge and face
+/// nodes into m.high_order (the inverse of gather_tet_nodes).
+void scatter_tet_nodes(TetMesh& m, TetId t, std::span<const Vec3> nodes);
+void scatter_tri_nodes(TetMesh& m, const std::array<VertId, 3>& tri, std::span<const Vec3> nodes);
+
+}  // namespace cm::mesh
