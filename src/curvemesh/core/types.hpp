@@ -4,6 +4,7 @@
 #include <limits>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace cm {
 

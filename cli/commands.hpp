@@ -1,0 +1,19 @@
+#pragma once
+// Subcommands of the curvemesh CLI. Each registers its options on the app
+// and returns the exit code (exit_codes.hpp) when run. Errors are thrown as
+// cm::InputError / cm::GeometryError / cm::InternalError and mapped to exit
+// codes in main.cpp.
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace cm::cli {
+
+using Runner = std::function<int()>;
+
+/// `curvemesh check MESH [--json FILE]`
+void add_check_command(CLI::App& app, Runner& runner);
+/// `curvemesh convert IN OUT`
+void add_convert_command(CLI::App& app, Runner& runner);
+
+}  // namespace cm::cli
