@@ -4,7 +4,6 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -42,10 +41,24 @@ void AtomicFile::commit() {
 }
 
 std::string read_file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, -1, -1, fmt::format("cannot open file: {}", std::strerror(errno)));
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path, -1, -1, "read error");
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw InputError(path, -1, -1, fmt::format("cannot open file: {}", std::strerror(errno)));
+  // Size first, then one read: streaming through iterators costs as much as parsing.
+  std::string data;
+  if (std::fseek(f, 0, SEEK_END) == 0) {
+    const long size = std::ftell(f);
+    if (size > 0) data.resize(static_cast<std::size_t>(size));
+    std::rewind(f);
+  }
+  const std::size_t got = data.empty() ? 0 : std::fread(data.data(), 1, data.size(), f);
+  data.resize(got);
+  // Pipes and special files report no size: read what comes.
+  char buf[1 << 16];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) data.append(buf, n);
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) throw InputError(path, -1, -1, "read error");
   return data;
 }
 

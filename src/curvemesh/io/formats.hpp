@@ -20,9 +20,19 @@ mesh::TetMesh read_msh(std::string_view bytes, const std::string& file_name);
 /// Gmsh MSH 4.1 with $Entities, parametric $Nodes and $Elements.
 void write_msh41(const mesh::TetMesh& m, const std::string& path, bool binary);
 
-/// Medit .mesh (ASCII) and .meshb (binary), detected from the content.
+/// Medit .mesh (ASCII) and .meshb (binary, libMeshb versions 1-4, either
+/// byte order), detected from the content. Reads Vertices, Edges, Triangles
+/// and Tetrahedra in any order; element references become edge_tag,
+/// face_tag and tet_region; vertex references are ignored (vert_class stays
+/// unclassified). Other keywords are skipped. Refuses Dimension 2 and the
+/// high-order keywords (EdgesP2, TrianglesP2, TetrahedraP2, ...), whose node
+/// order the format leaves open. A text file must end with End. O(size).
 mesh::TetMesh read_medit(std::string_view bytes, const std::string& file_name);
-/// Writes .meshb when binary, else .mesh.
+/// Writes .meshb (version 2; 3 above 2 GB, 4 when counts need 64 bits) when
+/// binary, else .mesh with coordinates that read back bit for bit. Vertex
+/// references are the vertex classification tags (0 if unclassified).
+/// Throws std::runtime_error for a mesh of order > 1 ("Medit format holds
+/// linear meshes only").
 void write_medit(const mesh::TetMesh& m, const std::string& path, bool binary);
 
 /// Per-tet data written as VTU cell data besides region and classification.
@@ -31,7 +41,14 @@ struct CellField {
   std::vector<double> values;  ///< one per tet
 };
 /// VTK XML unstructured grid: linear tets, or VTK_LAGRANGE_TETRAHEDRON /
-/// VTK_LAGRANGE_TRIANGLE for order >= 2. Cells: tets, then classified tris.
+/// VTK_LAGRANGE_TRIANGLE for order >= 2 in VTK's node order (points: the
+/// mesh vertices, then one per distinct edge / face node). Cells: tets, then
+/// classified tris. Cell data: "region" and "model_tag" (tet region or
+/// triangle face tag), "dim" (3 or 2), then each field (NaN on triangles).
+/// Point data: "class_dim" and "class_tag" of each point's classification
+/// (-1 and 0 for an unclassified vertex). Arrays are raw binary in one
+/// appended block. Throws std::invalid_argument for a field whose size is
+/// not the number of tets or whose name is already used.
 void write_vtu(const mesh::TetMesh& m, const std::string& path, std::span<const CellField> fields = {});
 
 /// A solution field in MMG's .sol conventions, one entry per vertex.
@@ -43,9 +60,13 @@ struct SolField {
   std::vector<double> values;
   std::size_t num_verts() const { return values.size() / (type == Type::kScalar ? 1 : 6); }
 };
-/// .sol (ASCII) or .solb (binary); the first field of type scalar or
-/// symmetric tensor at vertices is read.
+/// .sol (ASCII) or .solb (binary, versions 1-4), detected from the content;
+/// the first field of type scalar or symmetric tensor of SolAtVertices is
+/// read (other fields are skipped). Dimension must be 3 and every value
+/// finite. The caller checks num_verts() against its mesh.
 SolField read_sol(std::string_view bytes, const std::string& file_name);
+/// Writes one SolAtVertices field (.solb version 2, or 3 / 4 as for meshes).
+/// Throws std::invalid_argument for a partial tensor or a non-finite value.
 void write_sol(const SolField& sol, const std::string& path, bool binary);
 
 }  // namespace cm::io

@@ -1,1 +1,533 @@
-// filled in by the quality implementation
+#include "curvemesh/quality/bezier_jacobian.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "curvemesh/core/error.hpp"
+#include "curvemesh/core/predicates.hpp"
+#include "curvemesh/mesh/high_order.hpp"
+
+namespace cm::quality {
+
+namespace {
+
+constexpr int kMaxNodes = simplex_count(kMaxBezierOrder);
+constexpr int kMaxDerivs = simplex_count(kMaxBezierOrder - 1);
+constexpr int kMaxCoefs = simplex_count(kMaxJacobianDegree);
+constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
+
+// Pairs of local vertices along which a subdomain can be bisected (i < j).
+constexpr std::array<std::array<int, 2>, 6> kPairs{
+    {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+
+double gamma(int n) { return n * kUnitRoundoff / (1 - n * kUnitRoundoff); }
+
+// Everything that depends only on the geometric order p.
+struct OrderTables {
+  int order = 0;
+  int num_nodes = 0;
+  int num_derivs = 0;  // Bernstein basis of degree p-1
+  int num_coefs = 0;   // Bernstein basis of degree 3(p-1)
+  // Control point of rank m = sum_n lag2bez[m * num_nodes + n] * node n.
+  std::vector<double> lag2bez;
+  double lag2bez_norm = 0;  // max row sum of |entries|
+  // d/dxi_j control point of rank b = p (c[plus[j][b]] - c[base[b]]).
+  std::array<std::vector<int>, 3> plus;
+  std::vector<int> base;
+  // Triple products, loop order (g, d, b) flattened as (g * nd + d) * nd + b:
+  // coefficient target[k] += weight[k] * det(D1[b], D2[g], D3[d]).
+  std::vector<int> target;
+  std::vector<double> weight;
+  int max_terms = 0;  // most products summed into one coefficient
+};
+
+// Everything that depends only on the degree q of det J.
+struct DegreeTables {
+  int degree = 0;
+  int num_coefs = 0;
+  std::array<int, 4> corner{};
+  // For each pair of kPairs, the lines of coefficients along that pair: runs
+  // of ranks with a_i = r - s, a_j = s for s = 0..r, the other two fixed.
+  std::array<std::vector<int>, 6> line_ranks;
+  std::array<std::vector<int>, 6> line_lengths;
+};
+
+OrderTables build_order_tables(int p) {
+  OrderTables t;
+  t.order = p;
+  t.num_nodes = simplex_count(p);
+  t.num_derivs = simplex_count(p - 1);
+  t.num_coefs = simplex_count(3 * (p - 1));
+  const auto nodes = mesh::tet_node_indices(p);
+  const auto controls = bernstein_indices(p);
+  CM_ASSERT_OP(static_cast<int>(nodes.size()), ==, t.num_nodes);
+
+  // Node n is the value of sum_m c_m B_m at bary = nodes[n] / p. Inverted in
+  // long double so that the double entries are correctly rounded in practice.
+  using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+  MatL eval(t.num_nodes, t.num_nodes);
+  for (int n = 0; n < t.num_nodes; ++n)
+    for (int m = 0; m < t.num_nodes; ++m) {
+      long double v = multinomial(controls[static_cast<std::size_t>(m)]);
+      for (int k = 0; k < 4; ++k)
+        for (int e = 0; e < controls[static_cast<std::size_t>(m)][k]; ++e)
+          v *= static_cast<long double>(nodes[static_cast<std::size_t>(n)][k]) / p;
+      eval(n, m) = v;
+    }
+  const MatL inverse = eval.inverse();
+  t.lag2bez.resize(static_cast<std::size_t>(t.num_nodes * t.num_nodes));
+  for (int m = 0; m < t.num_nodes; ++m) {
+    double row = 0;
+    for (int n = 0; n < t.num_nodes; ++n) {
+      const double v = static_cast<double>(inverse(m, n));
+      t.lag2bez[static_cast<std::size_t>(m * t.num_nodes + n)] = v;
+      row += std::abs(v);
+    }
+    t.lag2bez_norm = std::max(t.lag2bez_norm, row);
+  }
+
+  const auto derivs = bernstein_indices(p - 1);
+  for (const MultiIndex& b : derivs) {
+    MultiIndex at0 = b;
+    ++at0[0];
+    t.base.push_back(bernstein_rank(at0));
+    for (int j = 0; j < 3; ++j) {
+      MultiIndex at = b;
+      ++at[j + 1];
+      t.plus[static_cast<std::size_t>(j)].push_back(bernstein_rank(at));
+    }
+  }
+
+  // B_b B_g B_d = M(b) M(g) M(d) / M(b+g+d) B_{b+g+d} (M = multinomial).
+  std::vector<int> terms(static_cast<std::size_t>(t.num_coefs), 0);
+  for (const MultiIndex& g : derivs)
+    for (const MultiIndex& d : derivs)
+      for (const MultiIndex& b : derivs) {
+        MultiIndex sum;
+        for (int k = 0; k < 4; ++k) sum[k] = b[k] + g[k] + d[k];
+        const int rank = bernstein_rank(sum);
+        t.target.push_back(rank);
+        t.weight.push_back(multinomial(b) * multinomial(g) * multinomial(d) / multinomial(sum));
+        ++terms[static_cast<std::size_t>(rank)];
+      }
+  t.max_terms = *std::max_element(terms.begin(), terms.end());
+  return t;
+}
+
+DegreeTables build_degree_tables(int q) {
+  DegreeTables t;
+  t.degree = q;
+  t.num_coefs = simplex_count(q);
+  for (int k = 0; k < 4; ++k) {
+    MultiIndex a{0, 0, 0, 0};
+    a[k] = q;
+    t.corner[static_cast<std::size_t>(k)] = bernstein_rank(a);
+  }
+  for (std::size_t pr = 0; pr < kPairs.size(); ++pr) {
+    const int i = kPairs[pr][0];
+    const int j = kPairs[pr][1];
+    int other[2];
+    int count = 0;
+    for (int k = 0; k < 4; ++k)
+      if (k != i && k != j) other[count++] = k;
+    for (int ak = 0; ak <= q; ++ak)
+      for (int al = 0; ak + al <= q; ++al) {
+        const int r = q - ak - al;
+        for (int s = 0; s <= r; ++s) {
+          MultiIndex a{};
+          a[other[0]] = ak;
+          a[other[1]] = al;
+          a[i] = r - s;
+          a[j] = s;
+          t.line_ranks[pr].push_back(bernstein_rank(a));
+        }
+        t.line_lengths[pr].push_back(r + 1);
+      }
+  }
+  return t;
+}
+
+const OrderTables& order_tables(int p) {
+  static const auto tables = [] {
+    std::array<OrderTables, kMaxBezierOrder + 1> t;
+    for (int o = 1; o <= kMaxBezierOrder; ++o) t[o] = build_order_tables(o);
+    return t;
+  }();
+  return tables[p];
+}
+
+const DegreeTables& degree_tables(int q) {
+  static const auto tables = [] {
+    std::array<DegreeTables, kMaxJacobianDegree + 1> t;
+    for (int d = 0; d <= kMaxJacobianDegree; ++d) t[d] = build_degree_tables(d);
+    return t;
+  }();
+  return tables[q];
+}
+
+void check_input(int order, std::span<const Vec3> nodes) {
+  if (order < 1 || order > kMaxBezierOrder)
+    throw std::invalid_argument(
+        fmt::format("element order {} is not supported (1..{})", order, kMaxBezierOrder));
+  if (static_cast<int>(nodes.size()) != simplex_count(order))
+    throw std::invalid_argument(fmt::format("an order-{} tet has {} nodes, got {}", order,
+                                            simplex_count(order), nodes.size()));
+  for (const Vec3& x : nodes)
+    if (!x.allFinite()) throw std::invalid_argument("tet node with a non-finite coordinate");
+}
+
+// Control points relative to node 0; returns max |coordinate| of the
+// translated nodes (the scale of their rounding error).
+double compute_control_points(const OrderTables& t, std::span<const Vec3> nodes, Vec3* control) {
+  std::array<Vec3, kMaxNodes> rel;
+  double scale = 0;
+  for (int n = 0; n < t.num_nodes; ++n) {
+    rel[static_cast<std::size_t>(n)] = nodes[static_cast<std::size_t>(n)] - nodes[0];
+    scale = std::max(scale, rel[static_cast<std::size_t>(n)].cwiseAbs().maxCoeff());
+  }
+  for (int m = 0; m < t.num_nodes; ++m) {
+    const double* row = t.lag2bez.data() + static_cast<std::size_t>(m * t.num_nodes);
+    Vec3 c = Vec3::Zero();
+    for (int n = 1; n < t.num_nodes; ++n) c += row[n] * rel[static_cast<std::size_t>(n)];
+    control[m] = c;
+  }
+  return scale;
+}
+
+// Coefficients of det J into coefs[0..num_coefs); returns the a-priori bound
+// E0 on their rounding error (see the header comment and certify_jacobian).
+double compute_coefficients(const OrderTables& t, std::span<const Vec3> nodes, double* coefs) {
+  std::array<Vec3, kMaxNodes> control;
+  const double node_scale = compute_control_points(t, nodes, control.data());
+  std::array<std::array<Vec3, kMaxDerivs>, 3> deriv;
+  double d_inf = 0;
+  double d_norm = 0;
+  for (int j = 0; j < 3; ++j)
+    for (int b = 0; b < t.num_derivs; ++b) {
+      const Vec3 d = t.order * (control[static_cast<std::size_t>(t.plus[j][b])] -
+                                control[static_cast<std::size_t>(t.base[b])]);
+      deriv[j][b] = d;
+      d_inf = std::max(d_inf, d.cwiseAbs().maxCoeff());
+      d_norm = std::max(d_norm, d.norm());
+    }
+  std::fill(coefs, coefs + t.num_coefs, 0.0);
+  const int nd = t.num_derivs;
+  std::size_t k = 0;
+  for (int g = 0; g < nd; ++g)
+    for (int d = 0; d < nd; ++d) {
+      const Vec3 cross = deriv[1][g].cross(deriv[2][d]);
+      for (int b = 0; b < nd; ++b, ++k) coefs[t.target[k]] += t.weight[k] * deriv[0][b].dot(cross);
+    }
+
+  // Error budget, in the order the computation happens:
+  // - control points: translation and the N-term products with lag2bez
+  //   (whose entries are correctly rounded), |err| <= gamma(N+4) |L| max|y|;
+  // - derivative control points: a difference times p, |err| <= e_d each;
+  // - each triple product changes by at most (|d| + sqrt3 e_d)^3 - |d|^3 under
+  //   those input errors (Hadamard), and is computed within gamma(5) of the
+  //   sum of its 6 absolute terms (<= 6 max|d_i|^3);
+  // - the weighted sum into a coefficient is a convex combination (weights sum
+  //   to 1) of at most max_terms terms: gamma(max_terms + 2) max|det|.
+  const double e_c = gamma(t.num_nodes + 4) * t.lag2bez_norm * node_scale;
+  const double e_d = 2 * t.order * e_c + 2.02 * kUnitRoundoff * d_inf;
+  const double pert = std::sqrt(3.0) * e_d;
+  const double d_norm1 = d_norm + pert;
+  const double d_inf1 = d_inf + e_d;
+  const double input_err = pert * (d_norm1 * d_norm1 + d_norm1 * d_norm + d_norm * d_norm);
+  const double product_err = 6 * gamma(5) * d_inf1 * d_inf1 * d_inf1;
+  const double sum_err = gamma(t.max_terms + 2) * d_norm1 * d_norm1 * d_norm1;
+  return 1.1 * (input_err + product_err + sum_err);
+}
+
+// One longest-edge bisection step of a subdomain: coefficients of the two
+// halves by de Casteljau at t = 1/2 along every line parallel to pair pr.
+// Child a keeps vertex i and puts the midpoint in slot j; child b keeps j and
+// puts the midpoint in slot i.
+void bisect_coefficients(const DegreeTables& t, std::size_t pr, const double* parent, double* a,
+                         double* b) {
+  const int* ranks = t.line_ranks[pr].data();
+  std::array<double, kMaxJacobianDegree + 1> w;
+  for (int len : t.line_lengths[pr]) {
+    const int r = len - 1;
+    for (int s = 0; s <= r; ++s) w[static_cast<std::size_t>(s)] = parent[ranks[s]];
+    a[ranks[0]] = w[0];
+    b[ranks[r]] = w[static_cast<std::size_t>(r)];
+    for (int level = 1; level <= r; ++level) {
+      for (int s = 0; s + level <= r; ++s)
+        w[static_cast<std::size_t>(s)] =
+            0.5 * (w[static_cast<std::size_t>(s)] + w[static_cast<std::size_t>(s + 1)]);
+      a[ranks[level]] = w[0];
+      b[ranks[r - level]] = w[static_cast<std::size_t>(r - level)];
+    }
+    ranks += len;
+  }
+}
+
+std::size_t longest_pair(const std::array<Bary, 4>& verts) {
+  // Lengths in xi = (l1, l2, l3); ties go to the first pair, deterministically.
+  std::size_t best = 0;
+  double best_len = -1;
+  for (std::size_t pr = 0; pr < kPairs.size(); ++pr) {
+    const Bary& u = verts[static_cast<std::size_t>(kPairs[pr][0])];
+    const Bary& v = verts[static_cast<std::size_t>(kPairs[pr][1])];
+    double len = 0;
+    for (int k = 1; k < 4; ++k) len += (u[k] - v[k]) * (u[k] - v[k]);
+    if (len > best_len) {
+      best_len = len;
+      best = pr;
+    }
+  }
+  return best;
+}
+
+struct Domain {
+  double min_coef;
+  double max_coef;
+  int slot;
+  int depth;
+};
+
+// Best-first subdivision state of one certification.
+class Search {
+ public:
+  Search(const DegreeTables& t, double err, const ValidityOptions& opt, ValidityReport& rep)
+      : tables_(t), err_(err), opt_(opt), rep_(rep) {}
+
+  void note_value(double v, const Bary& at) {
+    if (v < rep_.min_upper) {
+      rep_.min_upper = v;
+      rep_.where = at;
+    }
+    rep_.max_lower = std::max(rep_.max_lower, v);
+    if (v <= err_) invalid_ = true;
+  }
+
+  void push(const double* coefs, const std::array<Bary, 4>& verts, int depth) {
+    int slot;
+    if (!free_.empty()) {
+      slot = free_.back();
+      free_.pop_back();
+    } else {
+      slot = static_cast<int>(verts_.size());
+      verts_.emplace_back();
+      pool_.resize(pool_.size() + static_cast<std::size_t>(tables_.num_coefs));
+    }
+    std::copy(coefs, coefs + tables_.num_coefs, coefs_of(slot));
+    verts_[static_cast<std::size_t>(slot)] = verts;
+    const auto [lo, hi] = std::minmax_element(coefs, coefs + tables_.num_coefs);
+    heap_.push_back({*lo, *hi, slot, depth});
+    std::push_heap(heap_.begin(), heap_.end(), by_min);
+    rep_.depth_reached = std::max(rep_.depth_reached, depth);
+  }
+
+  void run(double gap_scale) {
+    int locate_left = opt_.locate_splits;
+    std::vector<double> child_a(static_cast<std::size_t>(tables_.num_coefs));
+    std::vector<double> child_b(static_cast<std::size_t>(tables_.num_coefs));
+    while (!heap_.empty()) {
+      const Domain top = heap_.front();
+      if (invalid_) {
+        // Only a subdomain whose bound is below the least known value (by more
+        // than the rounding) can hold a point worse than `where`.
+        if (locate_left <= 0 || top.min_coef >= rep_.min_upper - err_) break;
+      } else if (top.min_coef > err_) {
+        if (opt_.bound_tolerance <= 0 ||
+            rep_.min_upper - top.min_coef <= opt_.bound_tolerance * gap_scale)
+          break;
+      }
+      if (rep_.splits >= opt_.max_splits) break;
+      std::pop_heap(heap_.begin(), heap_.end(), by_min);
+      heap_.pop_back();
+      if (top.depth >= opt_.max_depth) {
+        retired_min_ = std::min(retired_min_, top.min_coef);
+        retired_max_ = std::max(retired_max_, top.max_coef);
+        free_.push_back(top.slot);
+        continue;
+      }
+      split(top, child_a.data(), child_b.data());
+      if (invalid_) --locate_left;
+    }
+  }
+
+  bool invalid() const { return invalid_; }
+
+  // Least and largest coefficient over the final subdivision.
+  std::pair<double, double> bounds() const {
+    double lo = retired_min_;
+    double hi = retired_max_;
+    for (const Domain& d : heap_) {
+      lo = std::min(lo, d.min_coef);
+      hi = std::max(hi, d.max_coef);
+    }
+    return {lo, hi};
+  }
+
+ private:
+  static bool by_min(const Domain& x, const Domain& y) { return x.min_coef > y.min_coef; }
+
+  double* coefs_of(int slot) {
+    return pool_.data() +
+           static_cast<std::size_t>(slot) * static_cast<std::size_t>(tables_.num_coefs);
+  }
+
+  void split(const Domain& d, double* a, double* b) {
+    ++rep_.splits;
+    const std::array<Bary, 4> verts = verts_[static_cast<std::size_t>(d.slot)];
+    const std::size_t pr = longest_pair(verts);
+    const auto i = static_cast<std::size_t>(kPairs[pr][0]);
+    const auto j = static_cast<std::size_t>(kPairs[pr][1]);
+    bisect_coefficients(tables_, pr, coefs_of(d.slot), a, b);
+    free_.push_back(d.slot);
+    Bary mid;
+    for (int k = 0; k < 4; ++k) mid[k] = 0.5 * (verts[i][k] + verts[j][k]);
+    note_value(a[tables_.corner[j]], mid);
+    std::array<Bary, 4> verts_a = verts;
+    std::array<Bary, 4> verts_b = verts;
+    verts_a[j] = mid;
+    verts_b[i] = mid;
+    push(a, verts_a, d.depth + 1);
+    push(b, verts_b, d.depth + 1);
+  }
+
+  const DegreeTables& tables_;
+  double err_;
+  const ValidityOptions& opt_;
+  ValidityReport& rep_;
+  bool invalid_ = false;
+  std::vector<double> pool_;
+  std::vector<std::array<Bary, 4>> verts_;
+  std::vector<int> free_;
+  std::vector<Domain> heap_;
+  double retired_min_ = std::numeric_limits<double>::infinity();
+  double retired_max_ = -std::numeric_limits<double>::infinity();
+};
+
+double scaled_lower(const ValidityReport& r) {
+  if (r.min_lower > 0) return r.min_lower / r.max_upper;
+  if (r.max_lower > 0) return r.min_lower / r.max_lower;
+  return -std::numeric_limits<double>::infinity();
+}
+
+ValidityReport certify_linear(std::span<const Vec3> nodes) {
+  ValidityReport rep;
+  const double det = (nodes[1] - nodes[0]).cross(nodes[2] - nodes[0]).dot(nodes[3] - nodes[0]);
+  const int sign =
+      predicates::orient3d(nodes[0].data(), nodes[1].data(), nodes[2].data(), nodes[3].data());
+  // The reported value follows the exact sign, even when rounding flipped det.
+  double value = det;
+  if (sign == 0)
+    value = 0;
+  else if ((det > 0) != (sign > 0))
+    value = sign * std::numeric_limits<double>::min();
+  rep.verdict = sign > 0 ? Validity::kValid : Validity::kInvalid;
+  rep.min_lower = rep.min_upper = rep.max_upper = rep.max_lower = value;
+  rep.scaled_jacobian_lower = scaled_lower(rep);
+  rep.where = {1, 0, 0, 0};
+  rep.where_entity = {0, 0};
+  return rep;
+}
+
+}  // namespace
+
+SubEntity classify_bary(const Bary& bary, double tol) {
+  std::array<int, 4> on{};
+  int count = 0;
+  for (int k = 0; k < 4; ++k)
+    if (bary[k] > tol) on[count++] = k;
+  if (count == 0) {
+    const auto largest = std::max_element(bary.begin(), bary.end()) - bary.begin();
+    return {0, static_cast<int>(largest)};
+  }
+  if (count == 1) return {0, on[0]};
+  if (count == 2) {
+    for (int e = 0; e < 6; ++e) {
+      const auto& ev = mesh::kTetEdges[e];
+      if ((ev[0] == on[0] && ev[1] == on[1]) || (ev[0] == on[1] && ev[1] == on[0])) return {1, e};
+    }
+  }
+  if (count == 3) {
+    // The face opposite the one vertex that is off.
+    for (int k = 0; k < 4; ++k)
+      if (!(bary[k] > tol)) return {2, k};
+  }
+  return {3, 0};
+}
+
+std::vector<double> jacobian_bezier_coefficients(int order, std::span<const Vec3> nodes) {
+  check_input(order, nodes);
+  const OrderTables& t = order_tables(order);
+  std::vector<double> coefs(static_cast<std::size_t>(t.num_coefs));
+  compute_coefficients(t, nodes, coefs.data());
+  return coefs;
+}
+
+std::vector<Vec3> geometry_control_points(int order, std::span<const Vec3> nodes) {
+  check_input(order, nodes);
+  const OrderTables& t = order_tables(order);
+  std::vector<Vec3> control(static_cast<std::size_t>(t.num_nodes));
+  compute_control_points(t, nodes, control.data());
+  for (Vec3& c : control) c += nodes[0];
+  return control;
+}
+
+ValidityReport certify_jacobian(int order, std::span<const Vec3> nodes,
+                                const ValidityOptions& options) {
+  check_input(order, nodes);
+  if (order == 1) return certify_linear(nodes);
+
+  const OrderTables& ot = order_tables(order);
+  const DegreeTables& dt = degree_tables(3 * (order - 1));
+  std::array<double, kMaxCoefs> root;
+  const double err0 = compute_coefficients(ot, nodes, root.data());
+  const auto [lo_it, hi_it] = std::minmax_element(root.begin(), root.begin() + dt.num_coefs);
+  const double lo = *lo_it;
+  const double hi = *hi_it;
+  // Subdivision only averages coefficients: each bisection adds at most
+  // `degree` roundings of size u max|coef| along any line.
+  const double magnitude = std::max(std::abs(lo), std::abs(hi)) + err0;
+  const double err = err0 + 1.1 * (options.max_depth * dt.degree + 2) * kUnitRoundoff * magnitude;
+
+  ValidityReport rep;
+  rep.rounding_bound = err;
+  rep.min_upper = std::numeric_limits<double>::infinity();
+  rep.max_lower = -std::numeric_limits<double>::infinity();
+  Search search(dt, err, options, rep);
+  const std::array<Bary, 4> unit{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
+  for (std::size_t k = 0; k < 4; ++k)
+    search.note_value(root[static_cast<std::size_t>(dt.corner[k])], unit[k]);
+
+  const double gap_scale = magnitude;
+  const bool settled = lo > err && (options.bound_tolerance <= 0 ||
+                                    rep.min_upper - lo <= options.bound_tolerance * gap_scale);
+  if (settled) {
+    // The common case for a good element: no subdivision, no allocation.
+    rep.verdict = Validity::kValid;
+    rep.min_lower = lo;
+    rep.max_upper = hi;
+  } else {
+    search.push(root.data(), unit, 0);
+    search.run(gap_scale);
+    const auto [lower, upper] = search.bounds();
+    rep.min_lower = lower;
+    rep.max_upper = upper;
+    if (search.invalid())
+      rep.verdict = Validity::kInvalid;
+    else
+      rep.verdict = lower > err ? Validity::kValid : Validity::kUndetermined;
+  }
+  rep.where_entity = classify_bary(rep.where, 0);
+  rep.scaled_jacobian_lower = scaled_lower(rep);
+  return rep;
+}
+
+ValidityReport certify_tet(const mesh::TetMesh& m, TetId t, const ValidityOptions& options) {
+  const auto nodes = mesh::gather_tet_nodes(m, t);
+  return certify_jacobian(m.high_order.order(), nodes, options);
+}
+
+}  // namespace cm::quality

@@ -1,1 +1,162 @@
-// filled in by the quality implementation
+#include "curvemesh/quality/measures.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "curvemesh/mesh/topology.hpp"
+
+namespace cm::quality {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+
+double sum_squared_edges(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm() +
+         (d - a).squaredNorm() + (d - b).squaredNorm() + (d - c).squaredNorm();
+}
+
+// Shared by the isotropic and metric forms: eta from a signed volume and the
+// sum of squared edge lengths measured in the same metric.
+double mean_ratio_from(double volume, double sum_sq) {
+  if (!(sum_sq > 0) || volume == 0) return 0;
+  const double eta = 12.0 * std::cbrt(9.0 * volume * volume) / sum_sq;
+  return volume > 0 ? eta : -eta;
+}
+
+// Normals (right-hand rule over kFaceVerts) of the 4 faces, each of length
+// twice the face area; outward for a positive tet.
+std::array<Vec3, 4> face_normals(const std::array<const Vec3*, 4>& v) {
+  std::array<Vec3, 4> n;
+  for (int f = 0; f < 4; ++f) {
+    const auto& fv = mesh::kFaceVerts[f];
+    n[f] = (*v[fv[1]] - *v[fv[0]]).cross(*v[fv[2]] - *v[fv[0]]);
+  }
+  return n;
+}
+
+}  // namespace
+
+double tet_signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return (b - a).cross(c - a).dot(d - a) / 6.0;
+}
+
+std::array<double, 6> tet_edge_lengths(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const std::array<const Vec3*, 4> v{&a, &b, &c, &d};
+  std::array<double, 6> out;
+  for (int e = 0; e < 6; ++e)
+    out[e] = (*v[mesh::kTetEdges[e][1]] - *v[mesh::kTetEdges[e][0]]).norm();
+  return out;
+}
+
+double tet_mean_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return mean_ratio_from(tet_signed_volume(a, b, c, d), sum_squared_edges(a, b, c, d));
+}
+
+double tet_radius_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double volume = tet_signed_volume(a, b, c, d);
+  if (!(volume > 0)) return std::numeric_limits<double>::infinity();
+  const auto n = face_normals({&a, &b, &c, &d});
+  const double area = 0.5 * (n[0].norm() + n[1].norm() + n[2].norm() + n[3].norm());
+  const auto lengths = tet_edge_lengths(a, b, c, d);
+  const double h_max = *std::max_element(lengths.begin(), lengths.end());
+  // rho = 3V / area, so Q = alpha h_max area / (3V).
+  const double alpha = std::sqrt(6.0) / 12.0;
+  return alpha * h_max * area / (3.0 * volume);
+}
+
+double tet_inverse_radius_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double q = tet_radius_ratio(a, b, c, d);
+  return std::isinf(q) ? 0.0 : 1.0 / q;
+}
+
+std::array<double, 6> tet_dihedral_angles(const Vec3& a, const Vec3& b, const Vec3& c,
+                                          const Vec3& d) {
+  const auto n = face_normals({&a, &b, &c, &d});
+  std::array<double, 6> out;
+  for (int e = 0; e < 6; ++e) {
+    // The two faces sharing edge (i,j) are those opposite the other two vertices.
+    const int i = mesh::kTetEdges[e][0];
+    const int j = mesh::kTetEdges[e][1];
+    int other[2];
+    int count = 0;
+    for (int k = 0; k < 4; ++k)
+      if (k != i && k != j) other[count++] = k;
+    const Vec3& nk = n[other[0]];
+    const Vec3& nl = n[other[1]];
+    if (nk.squaredNorm() == 0 || nl.squaredNorm() == 0) {
+      out[e] = 0;
+      continue;
+    }
+    // Both normals outward (or both inward for an inverted tet): the interior
+    // angle is pi minus the angle between them. atan2 keeps precision near 0
+    // and 180 degrees, where acos of a dot product does not.
+    const double between = std::atan2(nk.cross(nl).norm(), nk.dot(nl));
+    out[e] = 180.0 - between * kRadToDeg;
+  }
+  return out;
+}
+
+AngleRange tet_dihedral_range(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const auto angles = tet_dihedral_angles(a, b, c, d);
+  const auto [lo, hi] = std::minmax_element(angles.begin(), angles.end());
+  return {*lo, *hi};
+}
+
+double metric_length(const Vec3& e, const Mat3& metric) {
+  return std::sqrt(std::max(0.0, e.dot(metric * e)));
+}
+
+double tet_metric_mean_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
+                             const Mat3& metric) {
+  const std::array<const Vec3*, 4> v{&a, &b, &c, &d};
+  double sum_sq = 0;
+  for (const auto& e : mesh::kTetEdges) {
+    const Vec3 edge = *v[e[1]] - *v[e[0]];
+    sum_sq += edge.dot(metric * edge);
+  }
+  const double volume =
+      std::sqrt(std::max(0.0, metric.determinant())) * tet_signed_volume(a, b, c, d);
+  return mean_ratio_from(volume, sum_sq);
+}
+
+Mat3 metric_log_mean(std::span<const Mat3> metrics) {
+  Mat3 log_sum = Mat3::Zero();
+  for (const Mat3& m : metrics) {
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(m);
+    const Vec3 log_values = eig.eigenvalues().array().max(std::numeric_limits<double>::min()).log();
+    log_sum += eig.eigenvectors() * log_values.asDiagonal() * eig.eigenvectors().transpose();
+  }
+  log_sum /= static_cast<double>(metrics.size());
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(log_sum);
+  const Vec3 values = eig.eigenvalues().array().exp();
+  return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+double triangle_mean_ratio(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double sum_sq = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
+  if (!(sum_sq > 0)) return 0;
+  const double area = 0.5 * (b - a).cross(c - a).norm();
+  return 4.0 * std::sqrt(3.0) * area / sum_sq;
+}
+
+TetQuality evaluate_tet(const mesh::TetMesh& m, TetId t) {
+  const auto& v = m.tet2verts[t];
+  const Vec3& a = m.coords[v[0]];
+  const Vec3& b = m.coords[v[1]];
+  const Vec3& c = m.coords[v[2]];
+  const Vec3& d = m.coords[v[3]];
+  TetQuality q;
+  q.volume = tet_signed_volume(a, b, c, d);
+  q.mean_ratio = mean_ratio_from(q.volume, sum_squared_edges(a, b, c, d));
+  q.radius_ratio = tet_radius_ratio(a, b, c, d);
+  const AngleRange range = tet_dihedral_range(a, b, c, d);
+  q.min_dihedral = range.min;
+  q.max_dihedral = range.max;
+  return q;
+}
+
+}  // namespace cm::quality

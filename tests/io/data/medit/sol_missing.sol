@@ -1,0 +1,3 @@
+MeshVersionFormatted 2
+Dimension 3
+End
