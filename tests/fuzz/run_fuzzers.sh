@@ -18,7 +18,7 @@ for reader in msh medit sol; do
   rm -rf "$corpus" && mkdir -p "$corpus"
   cp "$src/tests/fuzz/seeds/$reader/"* "$corpus/"
   echo "fuzz: $reader for ${seconds}s"
-  if ! (cd "$out" && "./fuzz_$reader" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  if ! (cd "$out" && "$out/tests/fuzz/fuzz_$reader" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
         -max_len=65536 -print_final_stats=1 "$corpus" >"$out/fuzz_$reader.log" 2>&1); then
     echo "fuzz: $reader FAILED" >&2
     tail -60 "$out/fuzz_$reader.log" >&2
