@@ -13,6 +13,8 @@ using Runner = std::function<int()>;
 
 /// `curvemesh check MESH [--json FILE]`
 void add_check_command(CLI::App& app, Runner& runner);
+/// `curvemesh info MODEL [--json FILE]` (with the OpenCASCADE backend)
+void add_info_command(CLI::App& app, Runner& runner);
 /// `curvemesh convert IN OUT`
 void add_convert_command(CLI::App& app, Runner& runner);
 

@@ -1,0 +1,205 @@
+#pragma once
+// Internal to geom_occ (includes OpenCASCADE): the geom::Model over a compound
+// of conformal solids. Never include this header outside geom_occ.
+//
+// Thread safety. Every table is filled by the constructor and only read
+// afterwards. Shape queries evaluate the Geom_Surface / Geom_Curve /
+// Geom2d_Curve handles directly: since OCCT 7.0 the B-spline span cache lives
+// in GeomAdaptor_* (mutable, per adaptor, NOT thread-safe) and no longer in
+// Geom_BSplineSurface/Curve, whose D0..D3 are const and read-only; offset,
+// revolution and extrusion surfaces built from Geom handles evaluate through
+// GeomEvaluator_* holding Geom handles, equally read-only. No query constructs
+// or touches a shared adaptor. The trimmed-face classifier
+// (BRepTopAdaptor_FClass2d::Perform) is const and builds its own adaptors per
+// call. Handle reference counts are atomic in OCCT.
+//
+// Tags: index in TopExp::MapShapes of the final shape, per dimension.
+// Orientation: each face is stored as oriented in its first (lowest-tag)
+// region, so face_normal, face_loops and the p-curves agree with that
+// region's outward normal; region_faces marks a use forward when the region
+// sees the face that way.
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <BRepTopAdaptor_FClass2d.hxx>
+#include <Geom2d_Curve.hxx>
+#include <Geom_Curve.hxx>
+#include <Geom_Surface.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
+#include <TopoDS_Solid.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+
+#include "curvemesh/geom/model.hpp"
+
+namespace cm::geom_occ::detail {
+
+/// A value computed on first use, exactly once, whichever thread asks first
+/// (mass properties are costly and only needed for validation).
+template <class T>
+class Lazy {
+ public:
+  template <class Compute>
+  const T& get(Compute&& compute) const {
+    std::call_once(flag_, [&] { value_ = compute(); });
+    return value_;
+  }
+
+ private:
+  mutable std::once_flag flag_;
+  mutable T value_{};
+};
+
+struct MassProperties {
+  double mass = 0;
+  Vec3 center = Vec3::Zero();
+};
+
+struct VertexData {
+  Vec3 point = Vec3::Zero();
+  double tolerance = 0;
+  std::vector<int> edges;
+};
+
+struct EdgeData {
+  TopoDS_Edge edge;  // FORWARD
+  Handle(Geom_Curve) curve;  // global coordinates, trimming wrappers removed; null if degenerate
+  double first = 0, last = 0;
+  bool degenerate = false;
+  geom::ShapeType type = geom::ShapeType::kOtherCurve;
+  std::array<int, 2> vertices{0, 0};
+  geom::ParamRange range;
+  double length = 0;
+  double tolerance = 0;  // BRep tolerance, raised to the measured curve / p-curve gap
+  geom::BoundingBox box;
+  std::vector<int> faces;
+  // Seeds of the global closest-point search: parameters and their points.
+  std::vector<double> sample_params;
+  std::vector<Vec3> sample_points;
+};
+
+/// The p-curve of one use of an edge in a face (seams have two uses).
+struct PCurveUse {
+  int edge = 0;
+  bool forward = true;
+  Handle(Geom2d_Curve) curve;
+};
+
+struct FaceData {
+  TopoDS_Face face;  // oriented as in its first region
+  Handle(Geom_Surface) surface;  // global coordinates, trimming wrappers removed
+  bool flip_normal = false;  // du x dv points into the first region
+  geom::ShapeType type = geom::ShapeType::kOtherSurface;
+  geom::ParamRange range;  // UV bounds of the trimmed face
+  // Box the projection's Newton iteration stays in (surface bounds in the
+  // non-periodic directions, open in the periodic ones).
+  double box_u0 = 0, box_u1 = 0, box_v0 = 0, box_v1 = 0;
+  std::unique_ptr<BRepTopAdaptor_FClass2d> classifier;
+  std::vector<geom::Loop> loops;
+  std::vector<int> edges;  // boundary edges, each once
+  std::vector<PCurveUse> pcurves;
+  std::vector<int> regions;
+  double tolerance = 0;
+  geom::BoundingBox box;  // edges' exact boxes and the padded sample grid
+  // Seeds of the global closest-point search, inside the trimmed face: the
+  // first grid_samples from a UV grid, then points of the boundary.
+  std::vector<Vec2> sample_params;
+  std::vector<Vec3> sample_points;
+  std::size_t grid_samples = 0;
+  Vec2 grid_step = Vec2::Zero();
+  // Parametric tolerance of the classifier (its ON band): the face's and its
+  // edges' 3D tolerance through the surface's resolution.
+  double uv_tolerance = 0;
+};
+
+struct RegionData {
+  TopoDS_Solid solid;
+  std::vector<geom::OrientedUse> faces;
+  double tolerance = 0;
+  geom::BoundingBox box;  // union of its faces' boxes
+};
+
+/// contains_param on a face's data (occ_queries.cpp).
+bool face_contains(const FaceData& face, Vec2 uv);
+
+/// Adds to `box` the interior maxima and minima of each coordinate over the
+/// trimmed face (occ_bounds.cpp); the boundary is the edges' business.
+void add_interior_extremes(const FaceData& face, geom::BoundingBox& box);
+
+/// The entity maps of the final shape: tag = index in these maps.
+struct ShapeMaps {
+  TopTools_IndexedMapOfShape vertices, edges, faces, solids;
+};
+
+class OccModel final : public geom::Model {
+ public:
+  /// `solids`: a shape whose solids are conformal (see make_conformal_solids).
+  OccModel(const TopoDS_Shape& solids, std::string units);
+
+  int count(int dim) const override;
+  geom::ShapeType type(geom::EntityRef e) const override;
+  geom::BoundingBox bounding_box(geom::EntityRef e) const override;
+  geom::BoundingBox bounding_box() const override { return box_; }
+  std::vector<geom::OrientedUse> region_faces(int region) const override;
+  std::vector<geom::Loop> face_loops(int face) const override;
+  std::array<int, 2> edge_vertices(int edge) const override;
+  bool is_degenerate(int edge) const override;
+  std::vector<int> upward(geom::EntityRef e) const override;
+  double tolerance(geom::EntityRef e) const override;
+  std::string units() const override { return units_; }
+
+  geom::ParamRange param_range(geom::EntityRef e) const override;
+  Vec3 vertex_point(int vertex) const override;
+  geom::CurveDerivatives edge_derivatives(int edge, double u) const override;
+  geom::SurfaceDerivatives face_derivatives(int face, const Vec2& uv) const override;
+  Vec3 face_normal(int face, const Vec2& uv) const override;
+  geom::Curvatures face_curvatures(int face, const Vec2& uv) const override;
+  double edge_curvature(int edge, double u) const override;
+  geom::Projection closest_point(geom::EntityRef e, const Vec3& x,
+                                 std::optional<Vec2> hint = {}) const override;
+  Vec2 edge_param_on_face(int edge, int face, double u, bool forward = true) const override;
+  bool contains_param(int face, const Vec2& uv) const override;
+
+  double area(int face) const override;
+  double length(int edge) const override;
+  double volume(int region) const override;
+  Vec3 center_of_mass(int region) const override;
+
+ private:
+  const VertexData& vertex_at(int tag) const;
+  const EdgeData& edge_at(int tag) const;
+  const FaceData& face_at(int tag) const;
+  const RegionData& region_at(int tag) const;
+
+  // Construction steps (occ_model.cpp).
+  void build_vertices(const TopoDS_Shape& shape, const ShapeMaps& maps);
+  void build_edges(const TopoDS_Shape& shape, const ShapeMaps& maps);
+  void build_regions(const ShapeMaps& maps);
+  void build_faces(const TopoDS_Shape& shape, const ShapeMaps& maps);
+  void build_face_loops(FaceData& face, const ShapeMaps& maps);
+  void build_face_samples(FaceData& face);
+
+  // Closest point (occ_projection.cpp).
+  geom::Projection project_on_edge(const EdgeData& edge, const Vec3& x,
+                                   std::optional<double> hint) const;
+  geom::Projection project_on_face(const FaceData& face, const Vec3& x,
+                                   std::optional<Vec2> hint) const;
+  geom::Projection project_on_face_boundary(const FaceData& face, const Vec3& x,
+                                            const Vec2& near_uv) const;
+  static Vec2 pcurve_point(const PCurveUse& use, double u);
+
+  std::vector<VertexData> vertices_;
+  std::vector<EdgeData> edges_;
+  std::vector<FaceData> faces_;
+  std::vector<RegionData> regions_;
+  std::unique_ptr<Lazy<double>[]> face_areas_;
+  std::unique_ptr<Lazy<MassProperties>[]> region_mass_;
+  geom::BoundingBox box_;
+  double scale_ = 1;  // model bounding-box diagonal: the length scale of iteration tolerances
+  std::string units_;
+};
+
+}  // namespace cm::geom_occ::detail

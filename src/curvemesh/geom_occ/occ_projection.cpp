@@ -1,0 +1,467 @@
+// Closest point on edges and trimmed faces.
+//
+// Both use a bound-constrained Newton iteration on f = |S(u,v) - x|^2 / 2
+// (exact Hessian, Gauss-Newton when it is not positive definite, backtracking
+// so f never increases). It starts from the caller's hint, or else from the
+// nearest of the seed samples stored at load time. On a face, the Newton box
+// is the face's UV box: when its minimizer lies inside the trimmed face it is
+// the closest point of the face; when it lies in a trimmed-away part, the
+// closest point is on the face's boundary and the best projection on its
+// edges is returned, with (u, v) from the edge's p-curve. The returned point
+// is always the entity evaluated at the returned parameters.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <Geom2d_Curve.hxx>
+#include <Standard_Failure.hxx>
+#include <gp_Pnt.hxx>
+#include <gp_Pnt2d.hxx>
+#include <gp_Vec2d.hxx>
+#include <gp_Vec.hxx>
+
+#include "curvemesh/core/error.hpp"
+#include "curvemesh/geom_occ/detail/occ_model.hpp"
+
+namespace cm::geom_occ::detail {
+
+namespace {
+
+constexpr int kMaxNewtonSteps = 60;
+constexpr int kMaxHalvings = 40;
+// Further Newton starts when the first ones leave the trimmed face.
+constexpr std::size_t kExtraStarts = 3;
+
+Vec3 to_vec(const gp_XYZ& p) { return {p.X(), p.Y(), p.Z()}; }
+
+struct SurfacePoint {
+  Vec3 p, du, dv, duu, duv, dvv;
+};
+
+SurfacePoint eval(const Geom_Surface& s, const Vec2& uv) {
+  gp_Pnt p;
+  gp_Vec du, dv, duu, dvv, duv;
+  s.D2(uv.x(), uv.y(), p, du, dv, duu, dvv, duv);
+  return {to_vec(p.XYZ()), to_vec(du.XYZ()), to_vec(dv.XYZ()),
+          to_vec(duu.XYZ()), to_vec(duv.XYZ()), to_vec(dvv.XYZ())};
+}
+
+struct NewtonResult {
+  Vec2 uv = Vec2::Zero();
+  Vec3 point = Vec3::Zero();
+  bool converged = false;
+};
+
+// Distance from x to an axis-aligned box (0 inside): a lower bound of the
+// distance to anything in the box.
+double box_distance(const geom::BoundingBox& b, const Vec3& x) {
+  const Vec3 below = (b.min - x).cwiseMax(0.0);
+  const Vec3 above = (x - b.max).cwiseMax(0.0);
+  return (below + above).norm();
+}
+
+double wrap(double t, double lo, double period) {
+  if (period <= 0) return t;
+  const double k = std::floor((t - lo) / period);
+  double w = t - k * period;
+  if (w >= lo + period) w -= period;
+  return w;
+}
+
+// Where a face's Newton iteration may go: [lo, hi] per direction, except
+// directions with a period > 0, which are unbounded and wrapped into
+// [origin, origin + period) to keep parameters small.
+struct SearchBox {
+  Vec2 lo, hi, origin, period;
+};
+
+SearchBox search_box(const FaceData& f) {
+  SearchBox b{Vec2(f.box_u0, f.box_v0), Vec2(f.box_u1, f.box_v1), Vec2(f.range.u0, f.range.v0),
+              Vec2::Zero()};
+  if (std::isinf(f.box_u0)) b.period.x() = f.range.period_u;
+  if (std::isinf(f.box_v0)) b.period.y() = f.range.period_v;
+  return b;
+}
+
+Vec2 into_box(Vec2 uv, const SearchBox& b) {
+  uv = uv.cwiseMax(b.lo).cwiseMin(b.hi);
+  for (int k = 0; k < 2; ++k)
+    if (b.period[k] > 0) uv[k] = wrap(uv[k], b.origin[k], b.period[k]);
+  return uv;
+}
+
+// Newton on a face's surface, (u, v) kept in the search box.
+NewtonResult newton_on_surface(const Geom_Surface& s, const Vec3& x, Vec2 uv, const SearchBox& box,
+                               double eps_len) {
+  const Vec2& lo = box.lo;
+  const Vec2& hi = box.hi;
+  uv = into_box(uv, box);
+  SurfacePoint sp = eval(s, uv);
+  NewtonResult out;
+  for (int iter = 0; iter < kMaxNewtonSteps; ++iter) {
+    const Vec3 r = sp.p - x;
+    const double f0 = r.squaredNorm();
+    const Vec2 g(sp.du.dot(r), sp.dv.dot(r));
+    // A direction at its bound with the gradient pushing outward stays fixed.
+    const bool free_u = !((uv.x() <= lo.x() && g.x() > 0) || (uv.x() >= hi.x() && g.x() < 0));
+    const bool free_v = !((uv.y() <= lo.y() && g.y() > 0) || (uv.y() >= hi.y() && g.y() < 0));
+    if (!free_u && !free_v) {
+      out.converged = true;
+      break;
+    }
+    const double jtj_uu = sp.du.squaredNorm(), jtj_uv = sp.du.dot(sp.dv),
+                 jtj_vv = sp.dv.squaredNorm();
+    double huu = jtj_uu + sp.duu.dot(r), huv = jtj_uv + sp.duv.dot(r), hvv = jtj_vv + sp.dvv.dot(r);
+    Vec2 step = Vec2::Zero();
+    if (free_u && free_v) {
+      double det = huu * hvv - huv * huv;
+      if (!(huu > 0 && det > 1e-14 * huu * hvv)) {
+        huu = jtj_uu;
+        huv = jtj_uv;
+        hvv = jtj_vv;
+        // Levenberg damping keeps a pole's singular metric solvable.
+        const double damping = 1e-12 * (huu + hvv) + 1e-300;
+        huu += damping;
+        hvv += damping;
+        det = huu * hvv - huv * huv;
+      }
+      step = Vec2(-(hvv * g.x() - huv * g.y()) / det, -(huu * g.y() - huv * g.x()) / det);
+    } else if (free_u) {
+      const double h = huu > 0 ? huu : jtj_uu + 1e-300;
+      step.x() = -g.x() / h;
+    } else {
+      const double h = hvv > 0 ? hvv : jtj_vv + 1e-300;
+      step.y() = -g.y() / h;
+    }
+    if (!std::isfinite(step.x()) || !std::isfinite(step.y())) break;
+    // Across a period the model is the same again: no longer steps.
+    for (int k = 0; k < 2; ++k)
+      if (box.period[k] > 0) step[k] = std::clamp(step[k], -0.5 * box.period[k], 0.5 * box.period[k]);
+    bool accepted = false;
+    Vec2 next = uv;
+    SurfacePoint sn;
+    double alpha = 1;
+    for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
+      next = into_box(uv + alpha * step, box);
+      sn = eval(s, next);
+      if ((sn.p - x).squaredNorm() <= f0) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      // No descent left in the Newton direction: a minimum to round-off.
+      out.converged = true;
+      break;
+    }
+    const double moved = (sn.p - sp.p).norm();
+    uv = next;
+    sp = sn;
+    if (moved <= eps_len) {
+      out.converged = true;
+      break;
+    }
+  }
+  out.uv = uv;
+  out.point = sp.p;
+  return out;
+}
+
+// Newton on t -> |S(pc(t)) - x|^2 / 2 along a p-curve's image, t in
+// [lo, hi]: the face's boundary as the surface sees it, which may stand off
+// the 3D edge by up to the edge's tolerance.
+double newton_on_pcurve(const Geom_Surface& s, const Geom2d_Curve& pc, const Vec3& x, double t,
+                        double lo, double hi, double eps_len) {
+  const auto evaluate = [&](double at, Vec3& point, Vec3& d1, Vec3& d2) {
+    gp_Pnt2d uv;
+    gp_Vec2d c1, c2;
+    pc.D2(at, uv, c1, c2);
+    const SurfacePoint sp = eval(s, Vec2(uv.X(), uv.Y()));
+    point = sp.p;
+    d1 = sp.du * c1.X() + sp.dv * c1.Y();
+    d2 = sp.duu * (c1.X() * c1.X()) + 2 * sp.duv * (c1.X() * c1.Y()) + sp.dvv * (c1.Y() * c1.Y()) +
+         sp.du * c2.X() + sp.dv * c2.Y();
+  };
+  Vec3 p, d1, d2;
+  evaluate(t, p, d1, d2);
+  for (int iter = 0; iter < kMaxNewtonSteps; ++iter) {
+    const Vec3 r = p - x;
+    const double g = d1.dot(r);
+    if ((t <= lo && g > 0) || (t >= hi && g < 0)) break;
+    double h = d1.squaredNorm() + d2.dot(r);
+    if (!(h > 0)) h = d1.squaredNorm();
+    if (!(h > 0)) break;
+    const double step = -g / h;
+    bool accepted = false;
+    double next = t;
+    Vec3 pn, n1, n2;
+    for (double alpha = 1; alpha > 1e-12; alpha *= 0.5) {
+      next = std::clamp(t + alpha * step, lo, hi);
+      evaluate(next, pn, n1, n2);
+      if ((pn - x).squaredNorm() <= r.squaredNorm()) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    const double moved = (pn - p).norm();
+    t = next;
+    p = pn;
+    d1 = n1;
+    d2 = n2;
+    if (moved <= eps_len) break;
+  }
+  return t;
+}
+
+}  // namespace
+
+geom::Projection OccModel::closest_point(geom::EntityRef e, const Vec3& x,
+                                         std::optional<Vec2> hint) const {
+  try {
+    switch (e.dim) {
+      case 0: {
+        const Vec3 p = vertex_at(e.tag).point;
+        return {p, Vec2::Zero(), (p - x).norm()};
+      }
+      case 1: {
+        std::optional<double> t;
+        if (hint) t = hint->x();
+        return project_on_edge(edge_at(e.tag), x, t);
+      }
+      case 2: return project_on_face(face_at(e.tag), x, hint);
+      default:
+        throw std::out_of_range(fmt::format("closest_point on a dimension-{} entity", e.dim));
+    }
+  } catch (const Standard_Failure& ex) {
+    throw GeometryError(fmt::format("closest point on entity ({}, {}) failed: {}", e.dim, e.tag,
+                                    ex.GetMessageString()));
+  }
+}
+
+geom::Projection OccModel::project_on_edge(const EdgeData& e, const Vec3& x,
+                                           std::optional<double> hint) const {
+  if (e.degenerate) {
+    const Vec3 p = e.sample_points.front();
+    return {p, Vec2(e.first, 0), (p - x).norm()};
+  }
+  const bool wraps = e.range.periodic_u;
+  const double lo = wraps ? -std::numeric_limits<double>::infinity() : e.first;
+  const double hi = wraps ? std::numeric_limits<double>::infinity() : e.last;
+  const double eps_len = 1e-13 * scale_;
+  const Geom_Curve& c = *e.curve;
+  const auto newton = [&](double t, bool& converged) {
+    t = std::clamp(t, lo, hi);
+    gp_Pnt p;
+    gp_Vec d1, d2;
+    c.D2(t, p, d1, d2);
+    converged = false;
+    for (int iter = 0; iter < kMaxNewtonSteps; ++iter) {
+      const Vec3 r = to_vec(p.XYZ()) - x;
+      const Vec3 v1 = to_vec(d1.XYZ()), v2 = to_vec(d2.XYZ());
+      const double g = v1.dot(r);
+      if ((t <= lo && g > 0) || (t >= hi && g < 0)) {
+        converged = true;
+        break;
+      }
+      double h = v1.squaredNorm() + v2.dot(r);
+      if (!(h > 0)) h = v1.squaredNorm();
+      if (!(h > 0)) break;
+      const double step = -g / h;
+      const double f0 = r.squaredNorm();
+      bool accepted = false;
+      double next = t;
+      gp_Pnt pn;
+      gp_Vec n1, n2;
+      double alpha = 1;
+      for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
+        next = std::clamp(t + alpha * step, lo, hi);
+        c.D2(next, pn, n1, n2);
+        if ((to_vec(pn.XYZ()) - x).squaredNorm() <= f0) {
+          accepted = true;
+          break;
+        }
+      }
+      if (!accepted) {
+        converged = true;
+        break;
+      }
+      const double moved = pn.Distance(p);
+      t = next;
+      p = pn;
+      d1 = n1;
+      d2 = n2;
+      if (moved <= eps_len) {
+        converged = true;
+        break;
+      }
+    }
+    return std::pair<double, Vec3>(t, to_vec(p.XYZ()));
+  };
+  const auto finish = [&](double t, const Vec3& p) {
+    if (wraps) {
+      t = wrap(t, e.first, e.range.period_u);
+      return geom::Projection{p, Vec2(t, 0), (p - x).norm()};
+    }
+    return geom::Projection{p, Vec2(t, 0), (p - x).norm()};
+  };
+  if (hint) {
+    bool converged = false;
+    const auto [t, p] = newton(*hint, converged);
+    if (converged) return finish(t, p);
+  }
+  // Global: start from the two best local minima of the seed distances, so a
+  // curve passing twice near x is not decided by one basin.
+  const auto& pts = e.sample_points;
+  const int n = static_cast<int>(pts.size());
+  int best = -1, second = -1;
+  double best_d = std::numeric_limits<double>::infinity(), second_d = best_d;
+  for (int k = 0; k < n; ++k) {
+    const double d = (pts[k] - x).squaredNorm();
+    const bool local_min = (k == 0 || d <= (pts[k - 1] - x).squaredNorm()) &&
+                           (k == n - 1 || d <= (pts[k + 1] - x).squaredNorm());
+    if (!local_min) continue;
+    if (d < best_d) {
+      second = best;
+      second_d = best_d;
+      best = k;
+      best_d = d;
+    } else if (d < second_d) {
+      second = k;
+      second_d = d;
+    }
+  }
+  bool converged = false;
+  auto [t, p] = newton(e.sample_params[best], converged);
+  if (second >= 0) {
+    const auto [t2, p2] = newton(e.sample_params[second], converged);
+    if ((p2 - x).squaredNorm() < (p - x).squaredNorm()) {
+      t = t2;
+      p = p2;
+    }
+  }
+  return finish(t, p);
+}
+
+geom::Projection OccModel::project_on_face(const FaceData& f, const Vec3& x,
+                                           std::optional<Vec2> hint) const {
+  const SearchBox box = search_box(f);
+  const double eps_len = 1e-13 * scale_;
+  const auto finish = [&](const Vec2& uv) {
+    // Evaluated again so that the point is bitwise face_point(param).
+    const gp_Pnt p = f.surface->Value(uv.x(), uv.y());
+    const Vec3 pv = to_vec(p.XYZ());
+    return geom::Projection{pv, uv, (pv - x).norm()};
+  };
+  const auto inside = [&](const Vec2& uv) { return face_contains(f, uv); };
+  if (hint) {
+    const NewtonResult r = newton_on_surface(*f.surface, x, *hint, box, eps_len);
+    if (r.converged && inside(r.uv)) return finish(r.uv);
+  }
+  // Two starts: the nearest interior seed and the nearest boundary seed. A
+  // point off a curved face can have a constrained local minimum on the
+  // boundary (where the surface continues past the face) besides the
+  // interior one, or the other way round.
+  const auto nearest = [&](std::size_t begin, std::size_t end) {
+    std::size_t best = end;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (std::size_t k = begin; k < end; ++k) {
+      const double d = (f.sample_points[k] - x).squaredNorm();
+      if (d < best_d) {
+        best_d = d;
+        best = k;
+      }
+    }
+    return best;
+  };
+  const std::size_t grid_end = f.grid_samples, all_end = f.sample_points.size();
+  std::optional<geom::Projection> found;
+  std::optional<Vec2> left_face;  // an answer outside the trimmed face
+  const auto descend_from = [&](std::size_t seed) {
+    const NewtonResult r = newton_on_surface(*f.surface, x, f.sample_params[seed], box, eps_len);
+    if (!inside(r.uv)) {
+      left_face = r.uv;
+      return;
+    }
+    const geom::Projection p = finish(r.uv);
+    if (!found || p.distance < found->distance) found = p;
+  };
+  for (const std::size_t seed : {nearest(0, grid_end), nearest(grid_end, all_end)})
+    if (seed < all_end) descend_from(seed);
+  if (left_face) {
+    // The descent left the face for a trimmed-away part of the surface:
+    // other basins of the face may hold its closest point. Try the next
+    // nearest grid seeds that are not neighbours of one already tried.
+    std::vector<std::pair<double, std::size_t>> order;
+    for (std::size_t k = 0; k < grid_end; ++k)
+      order.emplace_back((f.sample_points[k] - x).squaredNorm(), k);
+    const std::size_t extra = std::min<std::size_t>(order.size(), 16);
+    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(extra), order.end());
+    std::vector<Vec2> tried;
+    if (extra > 0) tried.push_back(f.sample_params[order[0].second]);
+    for (std::size_t i = 1; i < extra && tried.size() <= kExtraStarts; ++i) {
+      const Vec2& uv = f.sample_params[order[i].second];
+      const bool near_tried = std::any_of(tried.begin(), tried.end(), [&](const Vec2& t) {
+        return std::abs(t.x() - uv.x()) <= 1.5 * f.grid_step.x() &&
+               std::abs(t.y() - uv.y()) <= 1.5 * f.grid_step.y();
+      });
+      if (near_tried) continue;
+      tried.push_back(uv);
+      descend_from(order[i].second);
+    }
+  }
+  // Descent left the face: its closest point may be on the boundary.
+  if (left_face) {
+    const geom::Projection p = project_on_face_boundary(f, x, *left_face);
+    if (!found || p.distance < found->distance) found = p;
+  }
+  if (!found) throw GeometryError("closest point: face without seed samples");
+  return *found;
+}
+
+geom::Projection OccModel::project_on_face_boundary(const FaceData& f, const Vec3& x,
+                                                    const Vec2& near_uv) const {
+  geom::Projection best{Vec3::Zero(), Vec2::Zero(), std::numeric_limits<double>::infinity()};
+  int best_edge = 0;
+  for (const int tag : f.edges) {
+    const EdgeData& e = edges_[tag - 1];
+    if (e.degenerate || box_distance(e.box, x) >= best.distance) continue;
+    const geom::Projection p = project_on_edge(e, x, std::nullopt);
+    if (p.distance < best.distance) {
+      best = p;
+      best_edge = tag;
+    }
+  }
+  if (best_edge == 0) {
+    // Only degenerate edges (cannot happen on a valid face): keep the Newton answer.
+    const Vec3 p = to_vec(f.surface->Value(near_uv.x(), near_uv.y()).XYZ());
+    return {p, near_uv, (p - x).norm()};
+  }
+  // Refine along each p-curve of that edge (a seam has two: both sides are
+  // tried, the nearer kept, ties to the side nearer the unconstrained answer).
+  const EdgeData& edge = edges_[best_edge - 1];
+  geom::Projection result{Vec3::Zero(), near_uv, std::numeric_limits<double>::infinity()};
+  double uv_gap = std::numeric_limits<double>::infinity();
+  for (const PCurveUse& use : f.pcurves) {
+    if (use.edge != best_edge || use.curve.IsNull()) continue;
+    const double t = newton_on_pcurve(*f.surface, *use.curve, x, best.param.x(), edge.first,
+                                      edge.last, 1e-13 * scale_);
+    const Vec2 uv = pcurve_point(use, t);
+    const Vec3 p = to_vec(f.surface->Value(uv.x(), uv.y()).XYZ());
+    const double d = (p - x).norm();
+    const double gap = (uv - near_uv).squaredNorm();
+    if (d < result.distance || (d == result.distance && gap < uv_gap)) {
+      result = {p, uv, d};
+      uv_gap = gap;
+    }
+  }
+  if (std::isfinite(result.distance)) return result;
+  // No p-curve stored: locate the edge point on the surface.
+  const NewtonResult r = newton_on_surface(*f.surface, best.point, near_uv, search_box(f),
+                                           1e-13 * scale_);
+  const Vec3 p = to_vec(f.surface->Value(r.uv.x(), r.uv.y()).XYZ());
+  return {p, r.uv, (p - x).norm()};
+}
+
+}  // namespace cm::geom_occ::detail

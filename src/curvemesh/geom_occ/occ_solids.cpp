@@ -1,0 +1,188 @@
+// From the shape as read to a compound of closed, outward-oriented, mutually
+// conformal solids: healing, sewing, solid making and the general fuse.
+#include <algorithm>
+#include <vector>
+
+#include <BOPAlgo_Builder.hxx>
+#include <BRepBuilderAPI_MakeSolid.hxx>
+#include <BRepBuilderAPI_Sewing.hxx>
+#include <BRepCheck_Analyzer.hxx>
+#include <BRepClass3d_SolidClassifier.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <Message_Report.hxx>
+#include <Precision.hxx>
+#include <ShapeFix_Shape.hxx>
+#include <Standard_Failure.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
+#include <TopoDS_Shell.hxx>
+#include <TopoDS_Solid.hxx>
+
+#include "curvemesh/core/error.hpp"
+#include "curvemesh/geom_occ/detail/occ_shapes.hpp"
+
+namespace cm::geom_occ::detail {
+
+namespace {
+
+int count_of(const TopoDS_Shape& s, TopAbs_ShapeEnum type) {
+  TopTools_IndexedMapOfShape map;
+  TopExp::MapShapes(s, type, map);
+  return map.Extent();
+}
+
+double largest_vertex_tolerance(const TopoDS_Shape& s) {
+  double tol = 0;
+  for (TopExp_Explorer ex(s, TopAbs_VERTEX); ex.More(); ex.Next())
+    tol = std::max(tol, BRep_Tool::Tolerance(TopoDS::Vertex(ex.Current())));
+  return tol;
+}
+
+// A free edge of `shell` (bounding one face only, not a seam, not
+// degenerate), as "face N (of the shell) near (x, y, z)"; "" if closed.
+std::string describe_free_edge(const TopoDS_Shape& shell) {
+  TopTools_IndexedMapOfShape faces;
+  TopExp::MapShapes(shell, TopAbs_FACE, faces);
+  TopTools_IndexedDataMapOfShapeListOfShape e2f;
+  TopExp::MapShapesAndAncestors(shell, TopAbs_EDGE, TopAbs_FACE, e2f);
+  for (int i = 1; i <= e2f.Extent(); ++i) {
+    const TopoDS_Edge& edge = TopoDS::Edge(e2f.FindKey(i));
+    if (BRep_Tool::Degenerated(edge) || e2f(i).Extent() != 1) continue;
+    const TopoDS_Face& face = TopoDS::Face(e2f(i).First());
+    if (BRep_Tool::IsClosed(edge, face)) continue;
+    double f = 0, l = 0;
+    const Handle(Geom_Curve) c = BRep_Tool::Curve(edge, f, l);
+    std::string where;
+    if (!c.IsNull()) {
+      const gp_Pnt p = c->Value(0.5 * (f + l));
+      where = fmt::format(" near ({:.6g}, {:.6g}, {:.6g})", p.X(), p.Y(), p.Z());
+    }
+    return fmt::format("face {} of {} has a free edge{}", faces.FindIndex(face), faces.Extent(),
+                       where);
+  }
+  return "";
+}
+
+TopoDS_Shape heal(const ReadShape& read, const LoadOptions& options, double tol) {
+  // Healing a valid shape may still rebuild wires and renumber entities, so
+  // valid input is left alone (tags then follow the file); the XSTEP
+  // translators already heal what they read.
+  const bool needed = options.heal_tolerance > 0 || !BRepCheck_Analyzer(read.shape).IsValid();
+  if (!needed) return read.shape;
+  ShapeFix_Shape fixer(read.shape);
+  fixer.SetPrecision(tol);
+  fixer.SetMinTolerance(std::min(tol, Precision::Confusion()));
+  fixer.SetMaxTolerance(std::max(tol * 10, 1e-3));
+  fixer.Perform();
+  return fixer.Shape();
+}
+
+std::vector<TopoDS_Solid> sew_into_solids(const TopoDS_Shape& shape, const LoadOptions& options,
+                                          double tol, const std::string& source) {
+  const int nfaces = count_of(shape, TopAbs_FACE);
+  if (nfaces == 0)
+    throw GeometryError(fmt::format(
+        "{}: no solid and no face: the model holds only {} edge(s) and {} vertex(es)", source,
+        count_of(shape, TopAbs_EDGE), count_of(shape, TopAbs_VERTEX)));
+  if (!options.sew)
+    throw GeometryError(fmt::format("{}: no solid ({} free face(s)) and sewing is disabled",
+                                    source, nfaces));
+  BRepBuilderAPI_Sewing sewing(tol);
+  for (TopExp_Explorer ex(shape, TopAbs_FACE); ex.More(); ex.Next()) sewing.Add(ex.Current());
+  sewing.Perform();
+  const TopoDS_Shape sewed = sewing.SewedShape();
+  std::vector<TopoDS_Solid> solids;
+  int shell_index = 0;
+  for (TopExp_Explorer ex(sewed, TopAbs_SHELL); ex.More(); ex.Next()) {
+    ++shell_index;
+    const TopoDS_Shell& shell = TopoDS::Shell(ex.Current());
+    if (!BRep_Tool::IsClosed(shell)) {
+      throw GeometryError(fmt::format(
+          "{}: no solid, and sewing the {} face(s) left shell {} open: {} (try a larger "
+          "heal tolerance, now {:g})",
+          source, nfaces, shell_index, describe_free_edge(shell), tol));
+    }
+    BRepBuilderAPI_MakeSolid make(shell);
+    if (!make.IsDone())
+      throw GeometryError(fmt::format("{}: closed shell {} cannot be made a solid", source,
+                                      shell_index));
+    solids.push_back(make.Solid());
+  }
+  // Faces sewing could not attach to any shell stay free.
+  int free_faces = 0;
+  for (TopExp_Explorer ex(sewed, TopAbs_FACE, TopAbs_SHELL); ex.More(); ex.Next()) ++free_faces;
+  if (solids.empty() || free_faces > 0)
+    throw GeometryError(fmt::format(
+        "{}: no solid, and {} of its {} face(s) could not be sewn into a closed shell", source,
+        solids.empty() ? nfaces : free_faces, nfaces));
+  return solids;
+}
+
+// Makes every solid closed and outward-oriented, naming the culprit otherwise.
+void check_and_orient(std::vector<TopoDS_Solid>& solids, const std::string& source) {
+  for (std::size_t i = 0; i < solids.size(); ++i) {
+    int shell_index = 0;
+    for (TopExp_Explorer ex(solids[i], TopAbs_SHELL); ex.More(); ex.Next()) {
+      ++shell_index;
+      if (!BRep_Tool::IsClosed(ex.Current()))
+        throw GeometryError(fmt::format("{}: solid {}: shell {} is not closed: {}", source, i + 1,
+                                        shell_index, describe_free_edge(ex.Current())));
+    }
+    // Inside-out solids see the point at infinity inside.
+    BRepClass3d_SolidClassifier classifier(solids[i]);
+    classifier.PerformInfinitePoint(Precision::Confusion());
+    if (classifier.State() == TopAbs_IN) solids[i].Reverse();
+  }
+}
+
+}  // namespace
+
+TopoDS_Shape make_conformal_solids(const ReadShape& read, const LoadOptions& options,
+                                   const std::string& source) {
+  if (read.shape.IsNull()) throw GeometryError(fmt::format("{}: the model is empty", source));
+  try {
+    const double tol = options.heal_tolerance > 0
+                           ? options.heal_tolerance
+                           : std::max(1e-7, largest_vertex_tolerance(read.shape));
+    const TopoDS_Shape shape = options.heal ? heal(read, options, tol) : read.shape;
+
+    std::vector<TopoDS_Solid> solids;
+    for (TopExp_Explorer ex(shape, TopAbs_SOLID); ex.More(); ex.Next())
+      solids.push_back(TopoDS::Solid(ex.Current()));
+    if (solids.empty()) solids = sew_into_solids(shape, options, tol, source);
+    check_and_orient(solids, source);
+
+    TopoDS_Compound result;
+    BRep_Builder builder;
+    builder.MakeCompound(result);
+    if (solids.size() == 1) {
+      builder.Add(result, solids.front());
+      return result;
+    }
+    // General fuse: splits the solids against each other and merges coincident
+    // faces, edges and vertices, so touching solids share their interface.
+    BOPAlgo_Builder fuse;
+    for (const TopoDS_Solid& s : solids) fuse.AddArgument(s);
+    fuse.SetRunParallel(false);  // deterministic and polite to the caller's threads
+    fuse.Perform();
+    if (fuse.HasErrors()) {
+      Standard_SStream report;
+      fuse.DumpErrors(report);
+      throw GeometryError(fmt::format("{}: the {} solids cannot be made conformal: {}", source,
+                                      solids.size(), report.str()));
+    }
+    for (TopExp_Explorer ex(fuse.Shape(), TopAbs_SOLID); ex.More(); ex.Next())
+      builder.Add(result, ex.Current());
+    return result;
+  } catch (const Standard_Failure& e) {
+    throw GeometryError(fmt::format("{}: OpenCASCADE failed while preparing the solids: {} ({})",
+                                    source, e.GetMessageString(), e.DynamicType()->Name()));
+  }
+}
+
+}  // namespace cm::geom_occ::detail
