@@ -177,10 +177,10 @@ class Layout {
   // else a volume of its own (a vertex in no element).
   void classify_vertices() {
     vert_ref_ = m_.vert_class;
-    std::vector<std::size_t> todo;
+    std::vector<std::size_t> unplaced;
     for (VertId v = 0; v < vert_ref_.size(); ++v)
-      if (!vert_ref_[v].valid()) todo.push_back(v);
-    if (todo.empty()) return;
+      if (!vert_ref_[v].valid()) unplaced.push_back(v);
+    if (unplaced.empty()) return;
     std::vector<ModelRef> fallback(m_.num_verts());
     const auto offer = [&](VertId v, ModelRef r) {
       if (!fallback[v].valid()) fallback[v] = r;
@@ -195,7 +195,7 @@ class Layout {
     for (std::int32_t r : m_.tet_region) orphan_tag = std::max(orphan_tag, r);
     for (const auto& e : m_.entities)
       if (e.dim == 3) orphan_tag = std::max(orphan_tag, e.tag);
-    for (std::size_t v : todo)
+    for (std::size_t v : unplaced)
       vert_ref_[v] = fallback[v].valid() ? fallback[v] : ModelRef{3, orphan_tag + 1};
   }
 
