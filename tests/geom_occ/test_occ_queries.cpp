@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <thread>
 
@@ -85,6 +86,18 @@ std::vector<Probe> edge_probes(const geom::Model& m, int count, std::mt19937& rn
   return probes;
 }
 
+// How far a point can be from an entity and still count as on it: its
+// tolerance and, for a face, its boundary edges' (whose 3D curves and
+// p-curves disagree by up to that much).
+double on_tolerance(const geom::Model& m, const EntityRef& e) {
+  double tol = std::max(m.tolerance(e), 1e-7 * m.bounding_box().diagonal());
+  if (e.dim == 2) {
+    for (const geom::Loop& loop : m.face_loops(e.tag))
+      for (const geom::OrientedUse& use : loop.edges) tol = std::max(tol, m.tolerance({1, use.tag}));
+  }
+  return tol;
+}
+
 bool same_bits(const geom::Projection& a, const geom::Projection& b) {
   return std::memcmp(a.point.data(), b.point.data(), sizeof(double) * 3) == 0 &&
          std::memcmp(a.param.data(), b.param.data(), sizeof(double) * 2) == 0 &&
@@ -101,6 +114,7 @@ TEST_P(ModelQueries, ClosestPointIsOnTheEntityAndNoFartherThanKnownPoints) {
   const std::vector<Probe> on_edges = edge_probes(*model, 2000, rng);
   probes.insert(probes.end(), on_edges.begin(), on_edges.end());
 
+  const auto boundary_tolerance = [&](const EntityRef& e) { return on_tolerance(*model, e); };
   std::vector<geom::Projection> serial(probes.size());
   int off_entity = 0, farther = 0, outside = 0, hint_changed = 0;
   for (std::size_t i = 0; i < probes.size(); ++i) {
@@ -118,7 +132,10 @@ TEST_P(ModelQueries, ClosestPointIsOnTheEntityAndNoFartherThanKnownPoints) {
         ADD_FAILURE() << "probe " << i << " face " << p.entity.tag << ": (" << res.param.x()
                       << ", " << res.param.y() << ") is outside the trimmed face";
     }
-    if (p.source_on_entity && res.distance > (p.x - p.source).norm() + eps) {
+    // The known point may lie in the boundary's tolerance band, just off
+    // the face.
+    if (p.source_on_entity &&
+        res.distance > (p.x - p.source).norm() + (p.entity.dim == 2 ? boundary_tolerance(p.entity) : eps)) {
       if (++farther <= 5)
         ADD_FAILURE() << "probe " << i << " entity (" << p.entity.dim << ", " << p.entity.tag
                       << "): distance " << res.distance << " > " << (p.x - p.source).norm()
@@ -161,14 +178,9 @@ TEST_P(ModelQueries, ClosestPointIsOnTheEntityAndNoFartherThanKnownPoints) {
     if (!dist.IsDone()) continue;
     ++compared;
     const double expected = dist.Value() / f;
-    // The face's own tolerance and its edges': the model clamps to the
-    // boundary as the surface's p-curves draw it, BRepExtrema to 3D edges.
-    double tol = std::max(model->tolerance(p.entity), 1e-7 * scale);
-    if (p.entity.dim == 2) {
-      for (const geom::Loop& loop : model->face_loops(p.entity.tag))
-        for (const geom::OrientedUse& use : loop.edges)
-          tol = std::max(tol, model->tolerance({1, use.tag}));
-    }
+    // The model clamps to the boundary as the surface's p-curves draw it,
+    // BRepExtrema to the 3D edges: they may differ by the edges' tolerance.
+    const double tol = boundary_tolerance(p.entity);
     if (std::abs(serial[i].distance - expected) > tol) {
       if (++mismatched <= 5)
         ADD_FAILURE() << "probe " << i << " entity (" << p.entity.dim << ", " << p.entity.tag
@@ -188,9 +200,15 @@ TEST_P(ModelQueries, TrimmedFaceTestPCurvesAndNormalsAgreeWithOcc) {
   std::mt19937 rng(777);
   std::uniform_real_distribution<double> unit(0, 1);
   int unexplained = 0, classified = 0, pcurve_gaps = 0, wrong_side = 0, sided = 0, loop_sense = 0;
-  // About 1 500 classifications per model: the reference classifier projects
+  // About 600 classifications per model: the reference classifier projects
   // each 3D point on the face, which is slow on B-spline faces.
-  const int samples_per_face = std::clamp(1500 / model->count(2), 6, 30);
+  const int samples_per_face = std::clamp(600 / model->count(2), 2, 30);
+  // Normals against the solid classifier on about 40 faces.
+  const int sided_stride = std::max(1, model->count(2) / 40);
+  // One classifier per region: building one is costly (it indexes the solid).
+  std::vector<std::unique_ptr<BRepClass3d_SolidClassifier>> solids;
+  for (int region = 1; region <= model->count(3); ++region)
+    solids.push_back(std::make_unique<BRepClass3d_SolidClassifier>(ref.solids_map(region)));
   for (int face = 1; face <= model->count(2); ++face) {
     const TopoDS_Face& ref_face = TopoDS::Face(ref.faces(face));
     const geom::ParamRange r = model->param_range({2, face});
@@ -204,8 +222,8 @@ TEST_P(ModelQueries, TrimmedFaceTestPCurvesAndNormalsAgreeWithOcc) {
       const TopAbs_State theirs = BRepClass_FaceClassifier(ref_face, p, 1e-7 * scale * f).State();
       ++classified;
       if (ours == (theirs != TopAbs_OUT)) continue;
-      // Only near the boundary may two classifiers differ.
-      const double wide = std::max(1e-4 * face_size, model->tolerance({2, face})) * f;
+      // Only within the boundary's tolerance may two classifiers differ.
+      const double wide = 1.5 * std::max(1e-4 * face_size, on_tolerance(*model, {2, face})) * f;
       if (BRepClass_FaceClassifier(ref_face, p, wide).State() != TopAbs_ON) {
         if (++unexplained <= 5)
           ADD_FAILURE() << "face " << face << " (" << uv.x() << ", " << uv.y() << "): ours "
@@ -259,8 +277,9 @@ TEST_P(ModelQueries, TrimmedFaceTestPCurvesAndNormalsAgreeWithOcc) {
     // The normal points out of the face's first region: stepping a little
     // along it leaves the solid, stepping back enters it. Near an edge of a
     // thin face a step can cross another face, so three points vote.
+    if ((face - 1) % sided_stride != 0) continue;
     const int region = model->upward({2, face}).front();
-    BRepClass3d_SolidClassifier solid(ref.solids_map(region));
+    BRepClass3d_SolidClassifier& solid = *solids[region - 1];
     const double step = 1e-4 * scale;
     int right = 0, reversed = 0;
     for (int k = 0; k < 3; ++k) {

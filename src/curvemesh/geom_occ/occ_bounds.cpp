@@ -80,7 +80,7 @@ void add_interior_extremes(const FaceData& face, geom::BoundingBox& box) {
       const Vec2 uv =
           maximize_coordinate(*face.surface, face.sample_params[best], axis, sign, lo, hi, scale);
       // A maximum outside the trimmed face is bounded by the boundary edges.
-      if (face.classifier->Perform(gp_Pnt2d(uv.x(), uv.y()), true) == TopAbs_OUT) continue;
+      if (!face_contains(face, uv)) continue;
       const gp_Pnt p = face.surface->Value(uv.x(), uv.y());
       box.add(Vec3(p.X(), p.Y(), p.Z()));
     }

@@ -282,8 +282,9 @@ void OccModel::build_faces(const TopoDS_Shape& shape, const ShapeMaps& maps) {
     for (const int tag : d.edges) tol3d = std::max(tol3d, edges_[tag - 1].tolerance);
     const GeomAdaptor_Surface adaptor(d.surface);
     const geom::ParamRange& r = d.range;
-    d.uv_tolerance = std::clamp(std::min(adaptor.UResolution(tol3d), adaptor.VResolution(tol3d)),
-                                Precision::PConfusion(), 1e-3 * std::max(r.u1 - r.u0, r.v1 - r.v0));
+    const double from_3d = std::min(adaptor.UResolution(tol3d), adaptor.VResolution(tol3d));
+    d.uv_tolerance = std::clamp(std::max(from_3d, d.uv_loop_gap), Precision::PConfusion(),
+                                1e-3 * std::max(r.u1 - r.u0, r.v1 - r.v0));
     d.classifier = std::make_unique<BRepTopAdaptor_FClass2d>(
         TopoDS::Face(d.face.Oriented(TopAbs_FORWARD)), d.uv_tolerance);
     build_face_samples(d);
@@ -340,12 +341,34 @@ std::vector<EdgeUse> chain_in_uv(std::vector<EdgeUse> uses) {
 void raise_tolerance_to_pcurve_gap(EdgeData& e, const Geom_Surface& surface,
                                    const Handle(Geom2d_Curve)& pcurve) {
   if (e.degenerate || e.curve.IsNull() || pcurve.IsNull()) return;
-  constexpr int kSamples = 24;
+  const auto gap_at = [&](double t) {
+    const gp_Pnt2d uv = pcurve->Value(t);
+    return e.curve->Value(t).Distance(surface.Value(uv.X(), uv.Y()));
+  };
+  // The gap oscillates between the curves' knots: sample densely, then
+  // refine the largest sample's bracket by golden-section search.
+  constexpr int kSamples = 100;
+  const double h = (e.last - e.first) / kSamples;
+  int best = 0;
   double gap = 0;
   for (int k = 0; k <= kSamples; ++k) {
-    const double t = e.first + (e.last - e.first) * k / kSamples;
-    const gp_Pnt2d uv = pcurve->Value(t);
-    gap = std::max(gap, e.curve->Value(t).Distance(surface.Value(uv.X(), uv.Y())));
+    const double g = gap_at(e.first + h * k);
+    if (g > gap) {
+      gap = g;
+      best = k;
+    }
+  }
+  double a = e.first + h * std::max(best - 1, 0), b = e.first + h * std::min(best + 1, kSamples);
+  constexpr double kGolden = 0.6180339887498949;
+  for (int iter = 0; iter < 30; ++iter) {
+    const double c = b - kGolden * (b - a), d = a + kGolden * (b - a);
+    const double gc = gap_at(c), gd = gap_at(d);
+    gap = std::max({gap, gc, gd});
+    if (gc > gd) {
+      b = d;
+    } else {
+      a = c;
+    }
   }
   e.tolerance = std::max(e.tolerance, gap);
 }
@@ -391,6 +414,13 @@ void OccModel::build_face_loops(FaceData& d, const ShapeMaps& maps) {
     }
     geom::Loop loop;
     loop.outer = wire.IsSame(outer);
+    // Gaps between consecutive p-curves: the loop's own uncertainty in (u, v).
+    for (std::size_t k = 0; k < uses.size(); ++k) {
+      const EdgeUse& a = uses[k];
+      const EdgeUse& b = uses[(k + 1) % uses.size()];
+      if (!a.pcurve.IsNull() && !b.pcurve.IsNull())
+        d.uv_loop_gap = std::max(d.uv_loop_gap, a.end.Distance(b.start));
+    }
     for (const EdgeUse& u : uses) {
       raise_tolerance_to_pcurve_gap(edges_[u.tag - 1], *d.surface, u.pcurve);
       loop.edges.push_back({u.tag, u.forward});
@@ -415,7 +445,7 @@ void OccModel::build_face_samples(FaceData& d) {
   for (int i = 0; i < nu; ++i) {
     for (int j = 0; j < nv; ++j) {
       const Vec2 uv(r.u0 + (r.u1 - r.u0) * (i + 0.5) / nu, r.v0 + (r.v1 - r.v0) * (j + 0.5) / nv);
-      if (d.classifier->Perform(gp_Pnt2d(uv.x(), uv.y()), false) == TopAbs_OUT) continue;
+      if (!face_contains(d, uv)) continue;
       d.sample_params.push_back(uv);
       d.sample_points.push_back(to_vec(d.surface->Value(uv.x(), uv.y())));
     }

@@ -173,6 +173,7 @@ bool face_contains(const FaceData& f, Vec2 uv) {
   if (r.periodic_v && (uv.y() < r.v0 || uv.y() > r.v0 + r.period_v))
     uv.y() -= std::floor((uv.y() - r.v0) / r.period_v) * r.period_v;
   // ON (within the classifier's band, FaceData::uv_tolerance) counts as in.
+  const std::lock_guard<std::mutex> lock(*f.classifier_mutex);
   return f.classifier->Perform(gp_Pnt2d(uv.x(), uv.y()), true) != TopAbs_OUT;
 }
 

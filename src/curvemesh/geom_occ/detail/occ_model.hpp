@@ -9,9 +9,12 @@
 // Geom_BSplineSurface/Curve, whose D0..D3 are const and read-only; offset,
 // revolution and extrusion surfaces built from Geom handles evaluate through
 // GeomEvaluator_* holding Geom handles, equally read-only. No query constructs
-// or touches a shared adaptor. The trimmed-face classifier
-// (BRepTopAdaptor_FClass2d::Perform) is const and builds its own adaptors per
-// call. Handle reference counts are atomic in OCCT.
+// or touches a shared adaptor. The one shared OCC object with hidden mutable
+// state is the trimmed-face classifier, which is locked per face (see
+// FaceData::classifier); results never depend on which thread asks, so
+// answers are bitwise the same serially and in parallel. Handle reference
+// counts are atomic in OCCT. Mass properties are computed once on first use
+// (Lazy, std::call_once).
 //
 // Tags: index in TopExp::MapShapes of the final shape, per dimension.
 // Orientation: each face is stored as oriented in its first (lowest-tag)
@@ -97,7 +100,12 @@ struct FaceData {
   // Box the projection's Newton iteration stays in (surface bounds in the
   // non-periodic directions, open in the periodic ones).
   double box_u0 = 0, box_u1 = 0, box_v0 = 0, box_v1 = 0;
+  // BRepTopAdaptor_FClass2d::Perform is const but NOT safe to call from two
+  // threads at once: its polygons live in NCollection_Sequence members, whose
+  // const Value() moves a mutable "current node" cursor. Every use goes
+  // through face_contains, which holds classifier_mutex.
   std::unique_ptr<BRepTopAdaptor_FClass2d> classifier;
+  std::unique_ptr<std::mutex> classifier_mutex = std::make_unique<std::mutex>();
   std::vector<geom::Loop> loops;
   std::vector<int> edges;  // boundary edges, each once
   std::vector<PCurveUse> pcurves;
@@ -111,8 +119,10 @@ struct FaceData {
   std::size_t grid_samples = 0;
   Vec2 grid_step = Vec2::Zero();
   // Parametric tolerance of the classifier (its ON band): the face's and its
-  // edges' 3D tolerance through the surface's resolution.
+  // edges' 3D tolerance through the surface's resolution, and at least the
+  // largest gap between consecutive p-curves of a loop.
   double uv_tolerance = 0;
+  double uv_loop_gap = 0;
 };
 
 struct RegionData {
