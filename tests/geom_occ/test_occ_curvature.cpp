@@ -41,6 +41,7 @@ void expect_frame(const geom::Curvatures& k, const Vec3& n) {
   EXPECT_NEAR(k.dir1.dot(k.dir2), 0, 1e-12);
   EXPECT_NEAR(k.dir1.dot(n), 0, 1e-10);
   EXPECT_NEAR(k.dir2.dot(n), 0, 1e-10);
+  EXPECT_NEAR((k.dir1.cross(k.dir2) - n).norm(), 0, 1e-10);  // right-handed about n
   EXPECT_GE(k.k1, k.k2);
 }
 

@@ -1,6 +1,7 @@
 // load_model on bad input (each a typed error with a clear message), on
 // synthetic files exercising sewing, the general fuse, IGES and units, and
 // on the built-in shapes.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -264,6 +265,37 @@ TEST(OccBuiltins, PartIsAFilletedBlockWithTwoHolesAndAFreeformTop) {
   EXPECT_EQ(again->volume(1), part->volume(1));
   const auto scaled = load_model("builtin:part:scale=0.5");
   EXPECT_NEAR(scaled->volume(1), part->volume(1) / 8, 1e-6 * part->volume(1));
+}
+
+TEST(OccBuiltins, QueriesOnMissingEntitiesThrow) {
+  const auto box = load_model("builtin:box");
+  EXPECT_THROW(box->type({2, 7}), std::out_of_range);
+  EXPECT_THROW(box->type({2, 0}), std::out_of_range);
+  EXPECT_THROW(box->face_loops(0), std::out_of_range);
+  EXPECT_THROW(box->upward({1, 13}), std::out_of_range);
+  EXPECT_THROW(box->count(4), std::out_of_range);
+  EXPECT_THROW(box->closest_point({3, 1}, Vec3::Zero()), std::out_of_range);
+  // An edge of the box that does not bound face 1.
+  int foreign = 0;
+  for (int e = 1; e <= box->count(1) && foreign == 0; ++e) {
+    const auto up = box->upward({1, e});
+    if (std::find(up.begin(), up.end(), 1) == up.end()) foreign = e;
+  }
+  ASSERT_GT(foreign, 0);
+  EXPECT_THROW(box->edge_param_on_face(foreign, 1, 0.5), std::invalid_argument);
+}
+
+TEST(OccBuiltins, ExplicitHealingToleranceRunsShapeFixAndKeepsTheModel) {
+  LoadOptions heal;
+  heal.heal_tolerance = 1e-6;
+  const auto healed = load_model("builtin:part", heal);
+  const auto plain = load_model("builtin:part");
+  EXPECT_EQ(healed->count(3), 1);
+  EXPECT_EQ(healed->count(2), plain->count(2));
+  EXPECT_NEAR(healed->volume(1), plain->volume(1), 1e-6 * plain->volume(1));
+  LoadOptions raw;
+  raw.heal = false;
+  EXPECT_NEAR(load_model("builtin:part", raw)->volume(1), plain->volume(1), 1e-9 * plain->volume(1));
 }
 
 TEST(OccBuiltins, BadSpecificationsAreInputErrors) {

@@ -15,6 +15,8 @@ std::unique_ptr<geom::Model> load_model(const std::string& model, const LoadOpti
   const TopoDS_Shape solids = detail::make_conformal_solids(read, options, model);
   try {
     return std::make_unique<detail::OccModel>(solids, read.units);
+  } catch (const GeometryError& e) {
+    throw GeometryError(fmt::format("{}: {}", model, e.what()));
   } catch (const Standard_Failure& e) {
     throw GeometryError(fmt::format("{}: OpenCASCADE failed while indexing the model: {} ({})",
                                     model, e.GetMessageString(), e.DynamicType()->Name()));

@@ -30,6 +30,24 @@
 // over the file's solid. The healing tolerance is LoadOptions::heal_tolerance, or
 // when 0 the largest vertex tolerance of the model (at least 1e-7).
 //
+// Model conventions beyond geom::Model:
+// - tolerance(edge) is the B-rep tolerance raised to the measured gap between
+//   the edge's 3D curve and its p-curves: files often understate it (the
+//   shared STEP models by up to 1e5 times). tolerance(region) is the largest
+//   tolerance of its faces.
+// - contains_param counts as inside a band around the boundary as wide as the
+//   face's and its edges' tolerance (in (u, v) through the surface's
+//   resolution), and at least the largest gap between consecutive p-curves
+//   of a loop.
+// - closest_point on a face returns (u, v) inside the trimmed face; when the
+//   unconstrained closest point of the surface is trimmed away, the closest
+//   point of the face's boundary as the p-curves draw it.
+// - type() of a degenerate edge is kPoint. bounding_box of an edge is exact
+//   (BRepBndLib optimal); of a face, its edges' boxes plus the interior
+//   extreme points found by ascent from a sample grid; of a region, the union
+//   of its faces'.
+// - area, volume and center_of_mass (BRepGProp) are computed on first use.
+//
 // Thread safety: load_model may be called from several threads, but the
 // STEP/IGES readers share process-wide XSTEP settings, so file reading is
 // serialized by an internal mutex. The returned model answers queries from any

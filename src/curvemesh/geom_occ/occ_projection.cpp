@@ -2,13 +2,20 @@
 //
 // Both use a bound-constrained Newton iteration on f = |S(u,v) - x|^2 / 2
 // (exact Hessian, Gauss-Newton when it is not positive definite, backtracking
-// so f never increases). It starts from the caller's hint, or else from the
-// nearest of the seed samples stored at load time. On a face, the Newton box
-// is the face's UV box: when its minimizer lies inside the trimmed face it is
-// the closest point of the face; when it lies in a trimmed-away part, the
-// closest point is on the face's boundary and the best projection on its
-// edges is returned, with (u, v) from the edge's p-curve. The returned point
-// is always the entity evaluated at the returned parameters.
+// so f never increases; periodic directions of a full-period entity wrap).
+// With a hint, Newton starts there and its answer stands if it converges
+// inside the entity. Otherwise (the global search) it starts from seed
+// samples stored at load time: on an edge the two best local minima of the
+// seed distances; on a face the nearest interior-grid seed and the nearest
+// boundary seed, and, when a descent leaves the trimmed face for a
+// trimmed-away part of the surface, a few more grid seeds from other basins
+// plus the projection on the face's boundary: the best edge by 3D distance,
+// refined along its p-curve image S(pc(t)), so that (u, v) lies on the
+// face's boundary as the surface draws it. The best candidate inside the
+// face wins. The returned point is bitwise the entity evaluated at the
+// returned parameters. Remaining weakness: a local minimum in a basin no
+// seed reaches can be returned instead of the global one (the grid is
+// 13-41 samples per direction).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -168,51 +175,77 @@ NewtonResult newton_on_surface(const Geom_Surface& s, const Vec3& x, Vec2 uv, co
   return out;
 }
 
-// Newton on t -> |S(pc(t)) - x|^2 / 2 along a p-curve's image, t in
-// [lo, hi]: the face's boundary as the surface sees it, which may stand off
-// the 3D edge by up to the edge's tolerance.
-double newton_on_pcurve(const Geom_Surface& s, const Geom2d_Curve& pc, const Vec3& x, double t,
-                        double lo, double hi, double eps_len) {
-  const auto evaluate = [&](double at, Vec3& point, Vec3& d1, Vec3& d2) {
-    gp_Pnt2d uv;
-    gp_Vec2d c1, c2;
-    pc.D2(at, uv, c1, c2);
-    const SurfacePoint sp = eval(s, Vec2(uv.X(), uv.Y()));
-    point = sp.p;
-    d1 = sp.du * c1.X() + sp.dv * c1.Y();
-    d2 = sp.duu * (c1.X() * c1.X()) + 2 * sp.duv * (c1.X() * c1.Y()) + sp.dvv * (c1.Y() * c1.Y()) +
-         sp.du * c2.X() + sp.dv * c2.Y();
-  };
-  Vec3 p, d1, d2;
-  evaluate(t, p, d1, d2);
+struct CurveJet {
+  Vec3 point, d1, d2;
+};
+
+// Newton on t -> |C(t) - x|^2 / 2 for a curve given by `jet` (t -> C, C',
+// C''), t kept in [lo, hi], or wrapped into [lo, lo + period) when period > 0
+// (then lo, hi only anchor the wrap). Sets `converged` unless it ran out of
+// steps.
+template <class Jet>
+double newton_1d(const Jet& jet, const Vec3& x, double t, double lo, double hi, double period,
+                 double eps_len, bool& converged) {
+  const auto keep = [&](double s) { return period > 0 ? wrap(s, lo, period) : std::clamp(s, lo, hi); };
+  t = keep(t);
+  CurveJet c = jet(t);
+  converged = false;
   for (int iter = 0; iter < kMaxNewtonSteps; ++iter) {
-    const Vec3 r = p - x;
-    const double g = d1.dot(r);
-    if ((t <= lo && g > 0) || (t >= hi && g < 0)) break;
-    double h = d1.squaredNorm() + d2.dot(r);
-    if (!(h > 0)) h = d1.squaredNorm();
+    const Vec3 r = c.point - x;
+    const double g = c.d1.dot(r);
+    if (period <= 0 && ((t <= lo && g > 0) || (t >= hi && g < 0))) {
+      converged = true;  // at an end, pushed outward
+      break;
+    }
+    double h = c.d1.squaredNorm() + c.d2.dot(r);
+    if (!(h > 0)) h = c.d1.squaredNorm();
     if (!(h > 0)) break;
-    const double step = -g / h;
+    double step = -g / h;
+    if (period > 0) step = std::clamp(step, -0.5 * period, 0.5 * period);
     bool accepted = false;
     double next = t;
-    Vec3 pn, n1, n2;
-    for (double alpha = 1; alpha > 1e-12; alpha *= 0.5) {
-      next = std::clamp(t + alpha * step, lo, hi);
-      evaluate(next, pn, n1, n2);
-      if ((pn - x).squaredNorm() <= r.squaredNorm()) {
+    CurveJet cn;
+    double alpha = 1;
+    for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
+      next = keep(t + alpha * step);
+      cn = jet(next);
+      if ((cn.point - x).squaredNorm() <= r.squaredNorm()) {
         accepted = true;
         break;
       }
     }
-    if (!accepted) break;
-    const double moved = (pn - p).norm();
+    if (!accepted) {
+      converged = true;  // no descent left: a minimum to round-off
+      break;
+    }
+    const double moved = (cn.point - c.point).norm();
     t = next;
-    p = pn;
-    d1 = n1;
-    d2 = n2;
-    if (moved <= eps_len) break;
+    c = cn;
+    if (moved <= eps_len) {
+      converged = true;
+      break;
+    }
   }
   return t;
+}
+
+CurveJet curve_jet(const Geom_Curve& curve, double t) {
+  gp_Pnt p;
+  gp_Vec d1, d2;
+  curve.D2(t, p, d1, d2);
+  return {to_vec(p.XYZ()), to_vec(d1.XYZ()), to_vec(d2.XYZ())};
+}
+
+// The image S(pc(t)) of a p-curve: the face's boundary as the surface sees
+// it, which may stand off the 3D edge by up to the edge's tolerance.
+CurveJet pcurve_jet(const Geom_Surface& s, const Geom2d_Curve& pc, double t) {
+  gp_Pnt2d uv;
+  gp_Vec2d c1, c2;
+  pc.D2(t, uv, c1, c2);
+  const SurfacePoint sp = eval(s, Vec2(uv.X(), uv.Y()));
+  return {sp.p, sp.du * c1.X() + sp.dv * c1.Y(),
+          sp.duu * (c1.X() * c1.X()) + 2 * sp.duv * (c1.X() * c1.Y()) + sp.dvv * (c1.Y() * c1.Y()) +
+              sp.du * c2.X() + sp.dv * c2.Y()};
 }
 
 }  // namespace
@@ -246,70 +279,21 @@ geom::Projection OccModel::project_on_edge(const EdgeData& e, const Vec3& x,
     const Vec3 p = e.sample_points.front();
     return {p, Vec2(e.first, 0), (p - x).norm()};
   }
-  const bool wraps = e.range.periodic_u;
-  const double lo = wraps ? -std::numeric_limits<double>::infinity() : e.first;
-  const double hi = wraps ? std::numeric_limits<double>::infinity() : e.last;
+  const double period = e.range.periodic_u ? e.range.period_u : 0;
   const double eps_len = 1e-13 * scale_;
-  const Geom_Curve& c = *e.curve;
+  const auto jet = [&](double t) { return curve_jet(*e.curve, t); };
   const auto newton = [&](double t, bool& converged) {
-    t = std::clamp(t, lo, hi);
-    gp_Pnt p;
-    gp_Vec d1, d2;
-    c.D2(t, p, d1, d2);
-    converged = false;
-    for (int iter = 0; iter < kMaxNewtonSteps; ++iter) {
-      const Vec3 r = to_vec(p.XYZ()) - x;
-      const Vec3 v1 = to_vec(d1.XYZ()), v2 = to_vec(d2.XYZ());
-      const double g = v1.dot(r);
-      if ((t <= lo && g > 0) || (t >= hi && g < 0)) {
-        converged = true;
-        break;
-      }
-      double h = v1.squaredNorm() + v2.dot(r);
-      if (!(h > 0)) h = v1.squaredNorm();
-      if (!(h > 0)) break;
-      const double step = -g / h;
-      const double f0 = r.squaredNorm();
-      bool accepted = false;
-      double next = t;
-      gp_Pnt pn;
-      gp_Vec n1, n2;
-      double alpha = 1;
-      for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
-        next = std::clamp(t + alpha * step, lo, hi);
-        c.D2(next, pn, n1, n2);
-        if ((to_vec(pn.XYZ()) - x).squaredNorm() <= f0) {
-          accepted = true;
-          break;
-        }
-      }
-      if (!accepted) {
-        converged = true;
-        break;
-      }
-      const double moved = pn.Distance(p);
-      t = next;
-      p = pn;
-      d1 = n1;
-      d2 = n2;
-      if (moved <= eps_len) {
-        converged = true;
-        break;
-      }
-    }
-    return std::pair<double, Vec3>(t, to_vec(p.XYZ()));
+    return newton_1d(jet, x, t, e.first, e.last, period, eps_len, converged);
   };
-  const auto finish = [&](double t, const Vec3& p) {
-    if (wraps) {
-      t = wrap(t, e.first, e.range.period_u);
-      return geom::Projection{p, Vec2(t, 0), (p - x).norm()};
-    }
+  // Evaluated again so that the point is bitwise edge_point(param).
+  const auto finish = [&](double t) {
+    const Vec3 p = jet(t).point;
     return geom::Projection{p, Vec2(t, 0), (p - x).norm()};
   };
   if (hint) {
     bool converged = false;
-    const auto [t, p] = newton(*hint, converged);
-    if (converged) return finish(t, p);
+    const double t = newton(*hint, converged);
+    if (converged) return finish(t);
   }
   // Global: start from the two best local minima of the seed distances, so a
   // curve passing twice near x is not decided by one basin.
@@ -333,15 +317,12 @@ geom::Projection OccModel::project_on_edge(const EdgeData& e, const Vec3& x,
     }
   }
   bool converged = false;
-  auto [t, p] = newton(e.sample_params[best], converged);
+  double t = newton(e.sample_params[best], converged);
   if (second >= 0) {
-    const auto [t2, p2] = newton(e.sample_params[second], converged);
-    if ((p2 - x).squaredNorm() < (p - x).squaredNorm()) {
-      t = t2;
-      p = p2;
-    }
+    const double t2 = newton(e.sample_params[second], converged);
+    if ((jet(t2).point - x).squaredNorm() < (jet(t).point - x).squaredNorm()) t = t2;
   }
-  return finish(t, p);
+  return finish(t);
 }
 
 geom::Projection OccModel::project_on_face(const FaceData& f, const Vec3& x,
@@ -349,10 +330,10 @@ geom::Projection OccModel::project_on_face(const FaceData& f, const Vec3& x,
   const SearchBox box = search_box(f);
   const double eps_len = 1e-13 * scale_;
   const auto finish = [&](const Vec2& uv) {
-    // Evaluated again so that the point is bitwise face_point(param).
-    const gp_Pnt p = f.surface->Value(uv.x(), uv.y());
-    const Vec3 pv = to_vec(p.XYZ());
-    return geom::Projection{pv, uv, (pv - x).norm()};
+    // Evaluated again (as face_derivatives does) so that the point is
+    // bitwise face_point(param).
+    const Vec3 p = eval(*f.surface, uv).p;
+    return geom::Projection{p, uv, (p - x).norm()};
   };
   const auto inside = [&](const Vec2& uv) { return face_contains(f, uv); };
   if (hint) {
@@ -435,7 +416,7 @@ geom::Projection OccModel::project_on_face_boundary(const FaceData& f, const Vec
   }
   if (best_edge == 0) {
     // Only degenerate edges (cannot happen on a valid face): keep the Newton answer.
-    const Vec3 p = to_vec(f.surface->Value(near_uv.x(), near_uv.y()).XYZ());
+    const Vec3 p = eval(*f.surface, near_uv).p;
     return {p, near_uv, (p - x).norm()};
   }
   // Refine along each p-curve of that edge (a seam has two: both sides are
@@ -445,10 +426,11 @@ geom::Projection OccModel::project_on_face_boundary(const FaceData& f, const Vec
   double uv_gap = std::numeric_limits<double>::infinity();
   for (const PCurveUse& use : f.pcurves) {
     if (use.edge != best_edge || use.curve.IsNull()) continue;
-    const double t = newton_on_pcurve(*f.surface, *use.curve, x, best.param.x(), edge.first,
-                                      edge.last, 1e-13 * scale_);
+    bool converged = false;
+    const double t = newton_1d([&](double s) { return pcurve_jet(*f.surface, *use.curve, s); }, x,
+                               best.param.x(), edge.first, edge.last, 0, 1e-13 * scale_, converged);
     const Vec2 uv = pcurve_point(use, t);
-    const Vec3 p = to_vec(f.surface->Value(uv.x(), uv.y()).XYZ());
+    const Vec3 p = eval(*f.surface, uv).p;
     const double d = (p - x).norm();
     const double gap = (uv - near_uv).squaredNorm();
     if (d < result.distance || (d == result.distance && gap < uv_gap)) {
@@ -460,7 +442,7 @@ geom::Projection OccModel::project_on_face_boundary(const FaceData& f, const Vec
   // No p-curve stored: locate the edge point on the surface.
   const NewtonResult r = newton_on_surface(*f.surface, best.point, near_uv, search_box(f),
                                            1e-13 * scale_);
-  const Vec3 p = to_vec(f.surface->Value(r.uv.x(), r.uv.y()).XYZ());
+  const Vec3 p = eval(*f.surface, r.uv).p;
   return {p, r.uv, (p - x).norm()};
 }
 

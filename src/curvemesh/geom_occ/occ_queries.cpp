@@ -152,7 +152,7 @@ Vec2 OccModel::edge_param_on_face(int edge, int face, double u, bool forward) co
     if (!found) found = &use;
   }
   if (!found)
-    throw std::out_of_range(fmt::format("edge {} does not bound face {}", edge, face));
+    throw std::invalid_argument(fmt::format("edge {} does not bound face {}", edge, face));
   if (!found->curve.IsNull()) return pcurve_point(*found, u);
   // No stored p-curve: locate the edge point on the surface instead.
   const Vec3 p = edge_derivatives(edge, u).point;
