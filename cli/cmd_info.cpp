@@ -31,14 +31,16 @@ struct CurvatureRange {
   int samples = 0;
 };
 
-// Principal curvatures on an n x n grid over the face's parameter box, keeping
-// only points inside the trimmed face.
+// Principal curvatures at the corners and centres of an n x n grid over the
+// face's parameter box (corners catch extremes on the box boundary, e.g. a
+// torus's inner equator), keeping only points inside the trimmed face.
 CurvatureRange sample_curvature(const geom::Model& g, int face, int n) {
   CurvatureRange r;
   const geom::ParamRange pr = g.param_range({2, face});
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const Vec2 uv(pr.u0 + (pr.u1 - pr.u0) * (i + 0.5) / n, pr.v0 + (pr.v1 - pr.v0) * (j + 0.5) / n);
+  for (int i = 0; i <= 2 * n; ++i)
+    for (int j = 0; j <= 2 * n; ++j) {
+      if ((i + j) % 2 != 0) continue;  // even: corner (both even) or centre (both odd)
+      const Vec2 uv(pr.u0 + (pr.u1 - pr.u0) * i / (2.0 * n), pr.v0 + (pr.v1 - pr.v0) * j / (2.0 * n));
       if (!g.contains_param(face, uv)) continue;
       const geom::Curvatures c = g.face_curvatures(face, uv);
       if (!std::isfinite(c.k1) || !std::isfinite(c.k2)) continue;
@@ -81,7 +83,8 @@ int run_info(const InfoOptions& o) {
     area += a;
     const CurvatureRange k = sample_curvature(g, f, o.samples);
     nlohmann::json fj = {{"tag", f}, {"type", geom::to_string(g.type({2, f}))}, {"area", a}, {"loops", g.face_loops(f).size()}};
-    if (k.samples > 0) fj["curvature"] = {{"min", k.k_min}, {"max", k.k_max}, {"samples", k.samples}};
+    // "+ 0.0" turns a plane's -0 curvature into 0 so users do not read a sign into it.
+    if (k.samples > 0) fj["curvature"] = {{"min", k.k_min + 0.0}, {"max", k.k_max + 0.0}, {"samples", k.samples}};
     faces.push_back(fj);
   }
   nlohmann::json edges = nlohmann::json::array();
@@ -129,7 +132,7 @@ void add_info_command(CLI::App& app, Runner& runner) {
   CLI::App* cmd = app.add_subcommand("info", "Describe a geometric model: topology, units, sizes, curvature");
   cmd->add_option("model", opts->model, "STEP/IGES/BREP file or builtin:NAME[:key=value,...]")->required();
   cmd->add_option("--json", opts->json_path, "Also write the description as JSON to this file");
-  cmd->add_option("--samples", opts->samples, "Curvature samples per parameter direction of each face")
+  cmd->add_option("--samples", opts->samples, "Curvature grid cells per parameter direction of each face (samples at corners and centres)")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--heal-tolerance", opts->heal_tolerance, "Healing/sewing tolerance (0: from the model)");

@@ -25,9 +25,7 @@ int main(int argc, char** argv) {
   Runner runner;
   add_check_command(app, runner);
   add_convert_command(app, runner);
-#ifdef CM_WITH_OCC
   add_info_command(app, runner);
-#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -6,7 +6,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <mutex>
+#include <sstream>
 #include <string_view>
 
 #include <BRepTools.hxx>
@@ -201,8 +203,27 @@ ReadShape read_brep(const std::string& path) {
                      "not an OpenCASCADE B-rep file: no 'CASCADE Topology' header");
   ReadShape out;
   BRep_Builder builder;
-  if (!BRepTools::Read(out.shape, path.c_str(), builder) || out.shape.IsNull())
-    throw InputError(path, -1, -1, "the B-rep reader rejected the file (damaged or truncated)");
+  // The B-rep reader reports its complaints on std::cout; catch them so the
+  // user sees one error line that carries the reader's reason.
+  std::ostringstream complaints;
+  std::streambuf* const saved = std::cout.rdbuf(complaints.rdbuf());
+  bool ok = false;
+  try {
+    ok = BRepTools::Read(out.shape, path.c_str(), builder);
+  } catch (...) {
+    std::cout.rdbuf(saved);
+    throw;
+  }
+  std::cout.rdbuf(saved);
+  if (!ok || out.shape.IsNull()) {
+    std::string reason = complaints.str();
+    while (!reason.empty() && std::isspace(static_cast<unsigned char>(reason.back()))) reason.pop_back();
+    for (std::size_t at = reason.find('\n'); at != std::string::npos; at = reason.find('\n', at))
+      reason.replace(at, 1, "; ");
+    throw InputError(path, -1, -1,
+                     "the B-rep reader rejected the file (damaged or truncated)" +
+                         (reason.empty() ? std::string() : ": " + reason));
+  }
   return out;
 }
 
