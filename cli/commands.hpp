@@ -13,8 +13,10 @@ using Runner = std::function<int()>;
 
 /// `curvemesh check MESH [--json FILE]`
 void add_check_command(CLI::App& app, Runner& runner);
-/// `curvemesh info MODEL [--json FILE]` (with the OpenCASCADE backend)
+/// `curvemesh info MODEL [--json FILE]` 
 void add_info_command(CLI::App& app, Runner& runner);
+/// `curvemesh size MODEL [-o size.vtu]`
+void add_size_command(CLI::App& app, Runner& runner);
 /// `curvemesh convert IN OUT`
 void add_convert_command(CLI::App& app, Runner& runner);
 

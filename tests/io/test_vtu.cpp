@@ -351,3 +351,51 @@ TEST(Vtu, RejectsFieldsThatDoNotFit) {
   EXPECT_THROW(cm::io::write_vtu(m, file, fields), std::invalid_argument);
   EXPECT_FALSE(fs::exists(file));
 }
+
+TEST(VtuGrid, VoxelsAndPointFieldsReadBack) {
+  cm::io::VtuGrid g;
+  // Two voxels side by side with unshared corners, plus a vertex cell.
+  for (int v = 0; v < 2; ++v)
+    for (int c = 0; c < 8; ++c) {
+      g.connectivity.push_back(static_cast<std::int64_t>(g.points.size()));
+      g.points.push_back(cm::Vec3(v + (c & 1), (c >> 1) & 1, (c >> 2) & 1));
+      if (c == 7) {
+        g.offsets.push_back(static_cast<std::int64_t>(g.connectivity.size()));
+        g.types.push_back(11);
+      }
+    }
+  g.connectivity.push_back(0);
+  g.offsets.push_back(17);
+  g.types.push_back(1);
+  g.cell_fields.push_back({"size", 1, {0.5, 0.25, 1.0}});
+  std::vector<double> dirs;
+  for (std::size_t i = 0; i < g.points.size(); ++i)
+    for (int a = 0; a < 3; ++a) dirs.push_back(a == 0 ? double(i) : 0.0);
+  g.point_fields.push_back({"dir", 3, dirs});
+  const fs::path file = fs::temp_directory_path() / fmt::format("cm_test_vtugrid_{}.vtu", static_cast<long>(getpid()));
+  cm::io::write_vtu_grid(g, file.string());
+  const Vtu vtu(cm::io::read_file_bytes(file.string()));
+  fs::remove(file);
+  EXPECT_EQ(vtu.num_points, 16);
+  EXPECT_EQ(vtu.num_cells, 3);
+  EXPECT_EQ(vtu.tail(), "\n  </AppendedData>\n</VTKFile>\n");
+  EXPECT_EQ(vtu.get<double>("size", "Float64"), (std::vector<double>{0.5, 0.25, 1.0}));
+  EXPECT_EQ(vtu.arrays.at("dir").components, 3);
+  EXPECT_EQ(vtu.get<double>("dir", "Float64"), dirs);
+  EXPECT_EQ(vtu.get<std::uint8_t>("types", "UInt8"), (std::vector<std::uint8_t>{11, 11, 1}));
+  EXPECT_EQ(vtu.get<std::int64_t>("offsets", "Int64"), (std::vector<std::int64_t>{8, 16, 17}));
+  const auto points = vtu.get<double>("Points", "Float64");
+  ASSERT_EQ(points.size(), 48u);
+  EXPECT_EQ(points[3 * 15], 2.0);
+
+  cm::io::VtuGrid bad = g;
+  bad.connectivity.back() = 99;
+  EXPECT_THROW(cm::io::write_vtu_grid(bad, file.string()), std::invalid_argument);
+  bad = g;
+  bad.cell_fields[0].values.pop_back();
+  EXPECT_THROW(cm::io::write_vtu_grid(bad, file.string()), std::invalid_argument);
+  bad = g;
+  bad.offsets[0] = 20;
+  EXPECT_THROW(cm::io::write_vtu_grid(bad, file.string()), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(file));
+}

@@ -51,6 +51,26 @@ struct CellField {
 /// not the number of tets or whose name is already used.
 void write_vtu(const mesh::TetMesh& m, const std::string& path, std::span<const CellField> fields = {});
 
+/// Any VTK unstructured grid, for data that is not a mesh (octree cells,
+/// sample point clouds): points, cells by VTK type with VTK's offsets (where
+/// each cell's connectivity ends), and Float64 point and cell fields of 1 or
+/// 3 components. Written like write_vtu (raw appended block, atomically).
+struct VtuGrid {
+  struct Field {
+    std::string name;
+    int components = 1;          ///< 1 or 3
+    std::vector<double> values;  ///< components per point (or cell)
+  };
+  std::vector<Vec3> points;
+  std::vector<std::int64_t> connectivity;
+  std::vector<std::int64_t> offsets;
+  std::vector<std::uint8_t> types;
+  std::vector<Field> point_fields, cell_fields;
+};
+/// Throws std::invalid_argument when sizes disagree, a field name repeats, or
+/// a cell refers to a point that does not exist.
+void write_vtu_grid(const VtuGrid& grid, const std::string& path);
+
 /// A solution field in MMG's .sol conventions, one entry per vertex.
 struct SolField {
   enum class Type { kScalar = 1, kTensor = 3 };

@@ -364,6 +364,44 @@ std::span<const std::byte> bytes_of(const std::vector<T>& v) {
   return std::as_bytes(std::span<const T>(v));
 }
 
+// Writes the XML header naming every array, then the appended block: each
+// array is a UInt64 byte count followed by its bytes, and each header entry's
+// `offset` counts from the first byte after the '_' marker.
+void write_appended_vtu(const std::string& path, std::size_t num_points, std::size_t num_cells,
+                        const std::array<const std::vector<Array>*, 4>& groups) {
+  std::string xml = fmt::format(
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" "
+      "header_type=\"UInt64\">\n"
+      "  <UnstructuredGrid>\n"
+      "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
+      std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian", num_points,
+      num_cells);
+  std::uint64_t offset = 0;
+  const std::array<std::string_view, 4> tags = {"PointData", "CellData", "Points", "Cells"};
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    xml += fmt::format("      <{}>\n", tags[g]);
+    for (const Array& a : *groups[g]) {
+      xml += fmt::format("        <DataArray {} format=\"appended\" offset=\"{}\"/>\n",
+                         a.attributes, offset);
+      offset += sizeof(std::uint64_t) + a.bytes();
+    }
+    xml += fmt::format("      </{}>\n", tags[g]);
+  }
+  xml += "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
+
+  AtomicFile file(path);
+  file.write(xml);
+  for (const auto* group : groups)
+    for (const Array& a : *group) {
+      const std::uint64_t n = a.bytes();
+      file.write(&n, sizeof n);
+      for (const auto& piece : a.pieces) file.write(piece.data(), piece.size());
+    }
+  file.write("\n  </AppendedData>\n</VTKFile>\n");
+  file.commit();
+}
+
 }  // namespace
 
 void write_vtu(const mesh::TetMesh& m, const std::string& path, std::span<const CellField> fields) {
@@ -398,42 +436,54 @@ void write_vtu(const mesh::TetMesh& m, const std::string& path, std::span<const 
   cells.push_back({R"(type="Int64" Name="offsets")", {bytes_of(g.offsets)}});
   cells.push_back({R"(type="UInt8" Name="types")", {bytes_of(g.types)}});
 
-  // Each array in the appended block is a UInt64 byte count, then the bytes;
-  // `offset` counts from the first byte after the '_' marker.
-  std::string xml = fmt::format(
-      "<?xml version=\"1.0\"?>\n"
-      "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" "
-      "header_type=\"UInt64\">\n"
-      "  <UnstructuredGrid>\n"
-      "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
-      std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian", num_points,
-      num_cells);
-  std::uint64_t offset = 0;
-  const auto section = [&](std::string_view tag, const std::vector<Array>& arrays) {
-    xml += fmt::format("      <{}>\n", tag);
-    for (const Array& a : arrays) {
-      xml += fmt::format("        <DataArray {} format=\"appended\" offset=\"{}\"/>\n",
-                         a.attributes, offset);
-      offset += sizeof(std::uint64_t) + a.bytes();
-    }
-    xml += fmt::format("      </{}>\n", tag);
-  };
-  section("PointData", point_data);
-  section("CellData", cell_data);
-  section("Points", points);
-  section("Cells", cells);
-  xml += "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
+  write_appended_vtu(path, num_points, num_cells, {&point_data, &cell_data, &points, &cells});
+}
 
-  AtomicFile file(path);
-  file.write(xml);
-  for (const auto* group : {&point_data, &cell_data, &points, &cells})
-    for (const Array& a : *group) {
-      const std::uint64_t n = a.bytes();
-      file.write(&n, sizeof n);
-      for (const auto& piece : a.pieces) file.write(piece.data(), piece.size());
-    }
-  file.write("\n  </AppendedData>\n</VTKFile>\n");
-  file.commit();
+void write_vtu_grid(const VtuGrid& grid, const std::string& path) {
+  const std::size_t num_points = grid.points.size(), num_cells = grid.types.size();
+  if (grid.offsets.size() != num_cells)
+    throw std::invalid_argument(
+        fmt::format("write_vtu_grid: {} offsets for {} cells", grid.offsets.size(), num_cells));
+  std::int64_t previous = 0;
+  for (const std::int64_t end : grid.offsets) {
+    if (end < previous || end > static_cast<std::int64_t>(grid.connectivity.size()))
+      throw std::invalid_argument("write_vtu_grid: offsets must increase up to the connectivity size");
+    previous = end;
+  }
+  if (previous != static_cast<std::int64_t>(grid.connectivity.size()))
+    throw std::invalid_argument("write_vtu_grid: the last offset must be the connectivity size");
+  for (const std::int64_t v : grid.connectivity)
+    if (v < 0 || v >= static_cast<std::int64_t>(num_points))
+      throw std::invalid_argument(fmt::format("write_vtu_grid: cell refers to point {} of {}", v, num_points));
+  std::set<std::string> names;
+  const auto check = [&](const VtuGrid::Field& f, std::size_t count, const char* what) {
+    if (f.components != 1 && f.components != 3)
+      throw std::invalid_argument(fmt::format("write_vtu_grid: field '{}' has {} components", f.name, f.components));
+    if (f.values.size() != count * static_cast<std::size_t>(f.components))
+      throw std::invalid_argument(fmt::format("write_vtu_grid: {} field '{}' has {} values for {} {}s", what,
+                                              f.name, f.values.size(), count, what));
+    if (!names.insert(f.name).second)
+      throw std::invalid_argument(fmt::format("write_vtu_grid: field name '{}' is used twice", f.name));
+  };
+  for (const auto& f : grid.point_fields) check(f, num_points, "point");
+  for (const auto& f : grid.cell_fields) check(f, num_cells, "cell");
+
+  const auto field_arrays = [](const std::vector<VtuGrid::Field>& fields) {
+    std::vector<Array> out;
+    for (const auto& f : fields)
+      out.push_back({fmt::format(R"(type="Float64" Name="{}" NumberOfComponents="{}")", xml_escape(f.name),
+                                 f.components),
+                     {bytes_of(f.values)}});
+    return out;
+  };
+  const std::vector<Array> point_data = field_arrays(grid.point_fields);
+  const std::vector<Array> cell_data = field_arrays(grid.cell_fields);
+  const std::vector<Array> points = {
+      {R"(type="Float64" Name="Points" NumberOfComponents="3")", {bytes_of(grid.points)}}};
+  const std::vector<Array> cells = {{R"(type="Int64" Name="connectivity")", {bytes_of(grid.connectivity)}},
+                                    {R"(type="Int64" Name="offsets")", {bytes_of(grid.offsets)}},
+                                    {R"(type="UInt8" Name="types")", {bytes_of(grid.types)}}};
+  write_appended_vtu(path, num_points, num_cells, {&point_data, &cell_data, &points, &cells});
 }
 
 }  // namespace cm::io

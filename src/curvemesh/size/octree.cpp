@@ -1,0 +1,513 @@
+#include "curvemesh/size/octree.hpp"
+
+#include "curvemesh/core/error.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <queue>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+namespace cm::size {
+
+namespace {
+
+constexpr int kMaxDepth = 20;           // keys pack 21 bits per axis
+constexpr int kMaxLevelJump = 3;
+// Sizes spread by gradation are resolved by octants up to twice their size:
+// a graded field varies slowly, and the trilinear interpolation follows it
+// (kGradeSafety covers what it overshoots). Requests themselves get eq. 4.6's
+// level exactly.
+constexpr double kResolution = 2;
+constexpr double kRefineMargin = 0.75;        // per refinement round: at most 8^3 children at once
+constexpr double kRelativeTolerance = 1e-12;
+// The corner graph is graded with a slightly smaller slope than hgrad asks:
+// trilinear interpolation of a convex field (sizes growing away from a
+// source) overshoots inside a larger octant, and between the centres of a
+// large and a small neighbour that overshoot adds to the slope.
+constexpr double kGradeSafety = 0.85;
+// Grading and conformity are alternated until neither moves a size by more
+// than this (relative); the last conformity pass is exact either way.
+constexpr double kConformTolerance = 1e-7;
+constexpr int kMaxConformPasses = 64;
+constexpr std::array<double, 4> kDiagonal = {0, 1, 1.4142135623730951, 1.7320508075688772};
+
+// Corner b of an octant: bit 0 -> +x, bit 1 -> +y, bit 2 -> +z.
+constexpr std::array<std::array<int, 3>, 8> kCorner = {
+    {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}}};
+
+// Hanging-corner candidates of an octant in half-side units: the 12 edge
+// midpoints with their 2 end corners and the 6 face centres with their 4.
+struct Midpoint {
+  std::array<int, 3> at;           // 0, 1 or 2 half-sides along each axis
+  std::array<int, 4> corners;      // -1 pads the edge case
+};
+std::vector<Midpoint> make_midpoints() {
+  std::vector<Midpoint> out;
+  for (int x = 0; x <= 2; ++x)
+    for (int y = 0; y <= 2; ++y)
+      for (int z = 0; z <= 2; ++z) {
+        const int ones = (x == 1) + (y == 1) + (z == 1);
+        if (ones != 1 && ones != 2) continue;  // corners and the centre are not on the boundary midpoints
+        Midpoint m{{x, y, z}, {-1, -1, -1, -1}};
+        int n = 0;
+        for (int c = 0; c < 8; ++c) {
+          const auto& k = kCorner[c];
+          const bool on = (x == 1 || 2 * k[0] == x) && (y == 1 || 2 * k[1] == y) && (z == 1 || 2 * k[2] == z);
+          if (on) m.corners[n++] = c;
+        }
+        out.push_back(m);
+      }
+  return out;
+}
+const std::vector<Midpoint>& midpoints() {
+  static const std::vector<Midpoint> m = make_midpoints();
+  return m;
+}
+
+}  // namespace
+
+// Keys are < 2^63, so all ones marks an empty slot.
+constexpr std::uint64_t kEmptyKey = ~std::uint64_t{0};
+
+void SizeOctree::CornerMap::reset(std::size_t expected) {
+  std::size_t capacity = 16;
+  shift_ = 60;
+  while (capacity < 2 * expected) {
+    capacity *= 2;
+    --shift_;
+  }
+  keys_.assign(capacity, kEmptyKey);
+  ids_.assign(capacity, 0);
+}
+
+std::size_t SizeOctree::CornerMap::slot(Key k) const {
+  // Fibonacci hashing: the top bits of the product mix every key bit.
+  return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> shift_);
+}
+
+std::uint32_t SizeOctree::CornerMap::insert(Key k, std::uint32_t id) {
+  const std::size_t mask = keys_.size() - 1;
+  for (std::size_t i = slot(k);; i = (i + 1) & mask) {
+    if (keys_[i] == k) return ids_[i];
+    if (keys_[i] == kEmptyKey) {
+      keys_[i] = k;
+      ids_[i] = id;
+      return id;
+    }
+  }
+}
+
+std::int64_t SizeOctree::CornerMap::find(Key k) const {
+  const std::size_t mask = keys_.size() - 1;
+  for (std::size_t i = slot(k);; i = (i + 1) & mask) {
+    if (keys_[i] == k) return ids_[i];
+    if (keys_[i] == kEmptyKey) return -1;
+  }
+}
+
+SizeOctree::SizeOctree(const geom::BoundingBox& box, const OctreeOptions& options) : opt_(options) {
+  if (!(opt_.hmin > 0) || !(opt_.hmax >= opt_.hmin) || !std::isfinite(opt_.hmax))
+    throw std::invalid_argument(fmt::format("size octree: need 0 < hmin <= hmax (got {}, {})", opt_.hmin, opt_.hmax));
+  if (!(opt_.hgrad >= 1)) throw std::invalid_argument(fmt::format("size octree: hgrad must be >= 1 (got {})", opt_.hgrad));
+  opt_.max_depth = std::clamp(opt_.max_depth, 1, kMaxDepth);
+  const Vec3 extent = box.size();
+  if (!extent.allFinite() || !(extent.maxCoeff() > 0))
+    throw std::invalid_argument("size octree: the bounding box is empty");
+  side_ = 1.02 * extent.maxCoeff();
+  origin_ = 0.5 * (box.min + box.max) - Vec3::Constant(0.5 * side_);
+  octants_.push_back({0, 0, 0, -1, 0});
+}
+
+std::array<std::uint32_t, 3> SizeOctree::to_units(const Vec3& x) const {
+  const double scale = std::ldexp(1.0, opt_.max_depth) / side_;
+  const double top = std::ldexp(1.0, opt_.max_depth) - 1;
+  std::array<std::uint32_t, 3> u{};
+  for (int a = 0; a < 3; ++a) {
+    double t = std::floor((x[a] - origin_[a]) * scale);
+    if (!(t >= 0)) t = 0;  // also NaN
+    u[a] = static_cast<std::uint32_t>(std::min(t, top));
+  }
+  return u;
+}
+
+Vec3 SizeOctree::to_point(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) const {
+  const double unit = std::ldexp(side_, -opt_.max_depth);
+  return origin_ + unit * Vec3(double(ix), double(iy), double(iz));
+}
+
+std::uint32_t SizeOctree::find(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const {
+  std::uint32_t o = 0;
+  while (octants_[o].first_child >= 0) {
+    const int bit = opt_.max_depth - octants_[o].level - 1;
+    const std::uint32_t child = ((ix >> bit) & 1u) | (((iy >> bit) & 1u) << 1) | (((iz >> bit) & 1u) << 2);
+    o = static_cast<std::uint32_t>(octants_[o].first_child) + child;
+  }
+  return o;
+}
+
+void SizeOctree::split(std::uint32_t o) {
+  const Octant parent = octants_[o];
+  CM_ASSERT(parent.first_child < 0 && parent.level < opt_.max_depth);
+  const std::uint32_t half = units(parent.level + 1);
+  octants_[o].first_child = static_cast<std::int32_t>(octants_.size());
+  for (int c = 0; c < 8; ++c)
+    octants_.push_back({parent.ix + kCorner[c][0] * half, parent.iy + kCorner[c][1] * half,
+                        parent.iz + kCorner[c][2] * half, -1, static_cast<std::uint8_t>(parent.level + 1)});
+}
+
+void SizeOctree::refine_to(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz, int level) {
+  level = std::min(level, opt_.max_depth);
+  std::uint32_t o = find(ix, iy, iz);
+  while (octants_[o].level < level) {
+    split(o);
+    o = find(ix, iy, iz);
+  }
+}
+
+void SizeOctree::insert(const Vec3& x, double h, SizeSource source) {
+  if (built_) throw std::logic_error("size octree: insert after build()");
+  if (!x.allFinite() || std::isnan(h) || !(h > 0))
+    throw std::invalid_argument(fmt::format("size octree: bad request h = {} at ({}, {}, {})", h, x.x(), x.y(), x.z()));
+  if (h < opt_.hmin) {
+    h = opt_.hmin;
+    source = SizeSource::kHmin;
+  }
+  if (h >= opt_.hmax) return;  // the default already
+  const auto u = to_units(x);
+  refine_to(u[0], u[1], u[2], octree_level(side_, h));
+  requests_.push_back({x, h, source});
+}
+
+void SizeOctree::insert(std::span<const SizeSample> samples) {
+  for (const SizeSample& s : samples) insert(s.point, s.size, s.source);
+}
+
+void SizeOctree::insert_field(std::shared_ptr<const SizeField> field) {
+  if (built_) throw std::logic_error("size octree: insert_field after build()");
+  if (!field) throw std::invalid_argument("size octree: null field");
+  fields_.push_back(std::move(field));
+}
+
+std::vector<std::uint32_t> SizeOctree::leaf_octants() const {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t o = 0; o < octants_.size(); ++o)
+    if (octants_[o].first_child < 0) out.push_back(o);
+  return out;
+}
+
+// 2:1 across faces, edges and corners: a leaf's 26 neighbouring leaves are at
+// most one level coarser. Keeps interpolation smooth and bounds the hanging
+// corners to edge midpoints and face centres.
+void SizeOctree::balance() {
+  std::vector<std::uint32_t> work = leaf_octants();
+  const std::int64_t top = std::int64_t{1} << opt_.max_depth;
+  while (!work.empty()) {
+    const std::uint32_t o = work.back();
+    work.pop_back();
+    if (octants_[o].first_child >= 0 || octants_[o].level < 2) continue;
+    const Octant me = octants_[o];
+    const std::int64_t s = units(me.level);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const auto probe = [&](std::int64_t lo, int d) { return d < 0 ? lo - 1 : d > 0 ? lo + s : lo; };
+          const std::int64_t px = probe(me.ix, dx), py = probe(me.iy, dy), pz = probe(me.iz, dz);
+          if (px < 0 || py < 0 || pz < 0 || px >= top || py >= top || pz >= top) continue;
+          for (;;) {
+            const std::uint32_t q = find(std::uint32_t(px), std::uint32_t(py), std::uint32_t(pz));
+            if (octants_[q].level + 1 >= me.level) break;
+            split(q);
+            const auto first = static_cast<std::uint32_t>(octants_[q].first_child);
+            for (std::uint32_t c = 0; c < 8; ++c) work.push_back(first + c);
+          }
+        }
+  }
+}
+
+void SizeOctree::assign_corners() {
+  leaves_ = leaf_octants();
+  octant_leaf_.assign(octants_.size(), -1);
+  leaf_nodes_.resize(leaves_.size());
+  node_of_.reset(2 * leaves_.size() + 8);  // corners <= 8 per leaf, ~1.2 per leaf in practice
+  leaf_side_.resize(leaves_.size());
+  node_units_.clear();
+  for (std::size_t l = 0; l < leaves_.size(); ++l) {
+    const Octant& o = octants_[leaves_[l]];
+    octant_leaf_[leaves_[l]] = static_cast<std::int32_t>(l);
+    leaf_side_[l] = std::ldexp(side_, -o.level);
+    const std::uint32_t s = units(o.level);
+    for (int c = 0; c < 8; ++c) {
+      const std::uint32_t x = o.ix + kCorner[c][0] * s, y = o.iy + kCorner[c][1] * s, z = o.iz + kCorner[c][2] * s;
+      const std::uint32_t id = node_of_.insert(key(x, y, z), std::uint32_t(node_units_.size()));
+      if (id == node_units_.size()) node_units_.push_back({x, y, z});
+      leaf_nodes_[l][c] = id;
+    }
+  }
+  const std::size_t n = node_units_.size();
+  node_value_.assign(n, opt_.hmax);
+  node_source_.assign(n, SizeSource::kHmax);
+  const auto lower = [&](std::uint32_t node, double h, SizeSource src) {
+    if (h < node_value_[node]) {
+      node_value_[node] = h;
+      node_source_[node] = src;
+    }
+  };
+  for (const Request& r : requests_) {
+    const auto u = to_units(r.x);
+    const std::int32_t l = octant_leaf_[find(u[0], u[1], u[2])];
+    for (const std::uint32_t node : leaf_nodes_[l]) lower(node, r.h, r.source);
+  }
+  for (const auto& field : fields_) {
+    const auto clamped = [&](const Vec3& x) { return std::clamp(field->size(x), opt_.hmin, opt_.hmax); };
+    std::vector<double> at_node(n), at_centre(leaves_.size());
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      at_node[i] = clamped(to_point(node_units_[i][0], node_units_[i][1], node_units_[i][2]));
+    });
+    tbb::parallel_for(std::size_t{0}, leaves_.size(), [&](std::size_t l) {
+      const Octant& o = octants_[leaves_[l]];
+      const std::uint64_t h = units(o.level) / 2;
+      at_centre[l] = o.level < opt_.max_depth ? clamped(to_point(o.ix + h, o.iy + h, o.iz + h))
+                                              : clamped(to_point(o.ix, o.iy, o.iz));
+    });
+    for (std::size_t i = 0; i < n; ++i) lower(std::uint32_t(i), at_node[i], SizeSource::kField);
+    for (std::size_t l = 0; l < leaves_.size(); ++l)
+      for (const std::uint32_t node : leaf_nodes_[l]) lower(node, at_centre[l], SizeSource::kField);
+  }
+}
+
+// Node -> incident leaves, corner positions and the hanging corners, once
+// per refinement round.
+void SizeOctree::build_incidence() {
+  const std::size_t n = node_value_.size();
+  incident_start_.assign(n + 1, 0);
+  for (const auto& corners : leaf_nodes_)
+    for (const std::uint32_t v : corners) ++incident_start_[v + 1];
+  for (std::size_t i = 0; i < n; ++i) incident_start_[i + 1] += incident_start_[i];
+  incident_.resize(incident_start_[n]);
+  std::vector<std::uint32_t> fill(incident_start_.begin(), incident_start_.end() - 1);
+  for (std::uint32_t l = 0; l < leaf_nodes_.size(); ++l)
+    for (std::uint32_t c = 0; c < 8; ++c) incident_[fill[leaf_nodes_[l][c]]++] = 8 * l + c;
+
+  hanging_.clear();
+  const auto& mids = midpoints();
+  for (std::uint32_t l = 0; l < leaves_.size(); ++l) {
+    const Octant& o = octants_[leaves_[l]];
+    if (o.level >= opt_.max_depth) continue;
+    const std::uint32_t half = units(o.level) / 2;
+    for (std::size_t k = 0; k < mids.size(); ++k) {
+      const auto& at = mids[k].at;
+      const std::int64_t node = node_of_.find(key(o.ix + at[0] * half, o.iy + at[1] * half, o.iz + at[2] * half));
+      if (node >= 0) hanging_.push_back({l, static_cast<std::uint32_t>(node), static_cast<std::uint8_t>(k)});
+    }
+  }
+  std::stable_sort(hanging_.begin(), hanging_.end(), [&](const Hanging& a, const Hanging& b) {
+    return octants_[leaves_[a.leaf]].level > octants_[leaves_[b.leaf]].level;
+  });
+}
+
+// Shortest paths from the seeds with their sizes as start distances:
+// h(b) = min over a of h(a) + (hgrad−1)|ab|, over corners of a common leaf.
+void SizeOctree::grade(std::span<const std::uint32_t> seeds) {
+  const double rate = kGradeSafety * (opt_.hgrad - 1);
+  using Item = std::pair<double, std::uint32_t>;
+  std::vector<Item> heap;
+  heap.reserve(seeds.size());
+  for (const std::uint32_t i : seeds)
+    if (node_value_[i] < opt_.hmax) heap.emplace_back(node_value_[i], i);
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue(std::greater<>{}, std::move(heap));
+  while (!queue.empty()) {
+    const auto [h, a] = queue.top();
+    queue.pop();
+    if (h > node_value_[a]) continue;
+    for (std::uint32_t k = incident_start_[a]; k < incident_start_[a + 1]; ++k) {
+      const std::uint32_t leaf = incident_[k] >> 3, ca = incident_[k] & 7u;
+      const double step = rate * leaf_side_[leaf];
+      const auto& corners = leaf_nodes_[leaf];
+      for (std::uint32_t cb = 0; cb < 8; ++cb) {
+        if (cb == ca) continue;
+        // Corners differing in 1, 2 or 3 coordinates: edge, face or body diagonal.
+        const double cand = h + step * kDiagonal[std::popcount(ca ^ cb)];
+        const std::uint32_t b = corners[cb];
+        if (cand < node_value_[b] * (1 - kConformTolerance)) {
+          node_value_[b] = cand;
+          node_source_[b] = SizeSource::kGradation;
+          queue.emplace(cand, b);
+        }
+      }
+    }
+  }
+}
+
+// Continuity at hanging corners; returns the corners whose size moved.
+std::vector<std::uint32_t> SizeOctree::conform() {
+  std::vector<std::uint32_t> moved;
+  const auto& mids = midpoints();
+  const auto interpolate = [&](const Hanging& hg) {
+    double sum = 0;
+    int count = 0;
+    for (const int c : mids[hg.midpoint].corners)
+      if (c >= 0) {
+        sum += node_value_[leaf_nodes_[hg.leaf][c]];
+        ++count;
+      }
+    return sum / count;
+  };
+  // Finest first: where a hanging corner asks for less than a larger
+  // octant interpolates there, lower that octant's corners on the face (or
+  // edge) to a common cap t, the least change that makes the interpolation
+  // equal to what the corner asks; corners already below t keep their size.
+  for (const Hanging& hg : hanging_) {
+    const double want = node_value_[hg.node];
+    if (!(interpolate(hg) - want > kConformTolerance * want)) continue;
+    std::array<double, 4> c;
+    c.fill(std::numeric_limits<double>::infinity());
+    int n = 0;
+    for (const int k : mids[hg.midpoint].corners)
+      if (k >= 0) c[n++] = node_value_[leaf_nodes_[hg.leaf][k]];
+    std::sort(c.begin(), c.end());
+    // Water filling: the mean of min(cᵢ, t) is `want`; with the k smallest
+    // below t, t = (n·want − Σ those) / (n − k).
+    double below = 0, cap = want;
+    for (int k = 0; k < n; ++k) {
+      const double t = (n * want - below) / (n - k);
+      if (t <= c[k]) {
+        cap = t;
+        break;
+      }
+      below += c[k];
+    }
+    for (const int k : mids[hg.midpoint].corners) {
+      if (k < 0) continue;
+      const std::uint32_t node = leaf_nodes_[hg.leaf][k];
+      if (node_value_[node] > cap) {
+        node_value_[node] = cap;
+        node_source_[node] = node_source_[hg.node];
+        moved.push_back(node);
+      }
+    }
+  }
+  // Coarsest first: a hanging corner takes the larger octant's value.
+  for (auto it = hanging_.rbegin(); it != hanging_.rend(); ++it) {
+    const double v = interpolate(*it);
+    if (std::abs(v - node_value_[it->node]) > kConformTolerance * node_value_[it->node]) moved.push_back(it->node);
+    node_value_[it->node] = v;
+  }
+  std::sort(moved.begin(), moved.end());
+  moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
+  return moved;
+}
+
+bool SizeOctree::refine_to_sizes() {
+  bool refined = false;
+  for (std::size_t l = 0; l < leaves_.size(); ++l) {
+    const Octant o = octants_[leaves_[l]];
+    double smallest = opt_.hmax;
+    for (const std::uint32_t node : leaf_nodes_[l]) smallest = std::min(smallest, node_value_[node]);
+    if (o.level >= std::min(octree_level(side_, kResolution * smallest), opt_.max_depth)) continue;
+    // Aim below the bound: the new corners, graded, come out somewhat
+    // smaller than interpolated, and a margin saves a whole round for them.
+    const int want = std::min({octree_level(side_, kRefineMargin * kResolution * smallest), opt_.max_depth,
+                               o.level + kMaxLevelJump});
+    refined = true;
+    // Every descendant down to `want`.
+    std::vector<std::uint32_t> stack{leaves_[l]};
+    while (!stack.empty()) {
+      const std::uint32_t q = stack.back();
+      stack.pop_back();
+      if (octants_[q].level >= want) continue;
+      split(q);
+      for (std::uint32_t c = 0; c < 8; ++c) stack.push_back(static_cast<std::uint32_t>(octants_[q].first_child) + c);
+    }
+  }
+  return refined;
+}
+
+void SizeOctree::build() {
+  if (built_) throw std::logic_error("size octree: build() called twice");
+  for (rounds_ = 1;; ++rounds_) {
+    balance();
+    assign_corners();
+    build_incidence();
+    std::vector<std::uint32_t> seeds(node_value_.size());
+    for (std::uint32_t i = 0; i < seeds.size(); ++i) seeds[i] = i;
+    for (int k = 0; k < kMaxConformPasses && !seeds.empty(); ++k) {
+      grade(seeds);
+      seeds = conform();
+    }
+    if (rounds_ >= 4 * opt_.max_depth || !refine_to_sizes()) break;
+  }
+  built_ = true;
+}
+
+double SizeOctree::size(const Vec3& x, const SizeHint&) const {
+  if (!built_) throw std::logic_error("size octree: query before build()");
+  const auto u = to_units(x);
+  const std::uint32_t o = find(u[0], u[1], u[2]);
+  const Octant& oct = octants_[o];
+  const auto& c = leaf_nodes_[static_cast<std::size_t>(octant_leaf_[o])];
+  const double s = std::ldexp(side_, -oct.level);
+  const Vec3 t = ((x - to_point(oct.ix, oct.iy, oct.iz)) / s).cwiseMax(0.0).cwiseMin(1.0);
+  const auto v = [&](int k) { return node_value_[c[k]]; };
+  const double x00 = v(0) + t.x() * (v(1) - v(0)), x10 = v(2) + t.x() * (v(3) - v(2));
+  const double x01 = v(4) + t.x() * (v(5) - v(4)), x11 = v(6) + t.x() * (v(7) - v(6));
+  const double y0 = x00 + t.y() * (x10 - x00), y1 = x01 + t.y() * (x11 - x01);
+  return y0 + t.z() * (y1 - y0);
+}
+
+std::vector<SizeOctree::Leaf> SizeOctree::leaves() const {
+  if (!built_) throw std::logic_error("size octree: leaves() before build()");
+  std::vector<Leaf> out(leaves_.size());
+  for (std::size_t l = 0; l < leaves_.size(); ++l) {
+    const Octant& o = octants_[leaves_[l]];
+    Leaf& leaf = out[l];
+    leaf.lo = to_point(o.ix, o.iy, o.iz);
+    leaf.level = o.level;
+    leaf.side = std::ldexp(side_, -o.level);
+    double sum = 0;
+    leaf.min_size = std::numeric_limits<double>::infinity();
+    for (const std::uint32_t node : leaf_nodes_[l]) {
+      sum += node_value_[node];
+      if (node_value_[node] < leaf.min_size) {
+        leaf.min_size = node_value_[node];
+        leaf.source = node_source_[node];
+      }
+    }
+    leaf.size = sum / 8;
+  }
+  return out;
+}
+
+std::vector<std::array<std::size_t, 2>> SizeOctree::face_neighbours() const {
+  if (!built_) throw std::logic_error("size octree: face_neighbours() before build()");
+  std::vector<std::array<std::size_t, 2>> out;
+  const std::int64_t top = std::int64_t{1} << opt_.max_depth;
+  for (std::size_t l = 0; l < leaves_.size(); ++l) {
+    const Octant& o = octants_[leaves_[l]];
+    const std::int64_t s = units(o.level);
+    for (int axis = 0; axis < 3; ++axis)
+      for (const int dir : {-1, 1}) {
+        std::array<std::int64_t, 3> p{o.ix, o.iy, o.iz};
+        p[axis] += dir < 0 ? -1 : s;
+        if (p[axis] < 0 || p[axis] >= top) continue;
+        const std::size_t other = static_cast<std::size_t>(
+            octant_leaf_[find(std::uint32_t(p[0]), std::uint32_t(p[1]), std::uint32_t(p[2]))]);
+        out.push_back({std::min(l, other), std::max(l, other)});
+      }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+int SizeOctree::depth() const {
+  int d = 0;
+  for (const Octant& o : octants_) d = std::max(d, int(o.level));
+  return d;
+}
+
+}  // namespace cm::size

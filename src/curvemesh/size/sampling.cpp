@@ -1,0 +1,298 @@
+#include "curvemesh/size/sampling.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include <tbb/parallel_for.h>
+
+namespace cm::size {
+
+const char* to_string(SizeSource s) {
+  switch (s) {
+    case SizeSource::kHmax: return "hmax";
+    case SizeSource::kFaceCurvature: return "face curvature";
+    case SizeSource::kEdgeCurvature: return "edge curvature";
+    case SizeSource::kEntitySize: return "entity size";
+    case SizeSource::kField: return "size field";
+    case SizeSource::kGradation: return "gradation";
+    case SizeSource::kHmin: return "hmin";
+  }
+  return "?";
+}
+
+SamplingStats& SamplingStats::operator+=(const SamplingStats& o) {
+  evaluations += o.evaluations;
+  outside += o.outside;
+  revisited += o.revisited;
+  subdivided += o.subdivided;
+  return *this;
+}
+
+namespace {
+
+// Sample points live on an integer lattice: a grid cell is `res` lattice
+// steps wide, fine enough for every corner and centroid down to max_depth,
+// so a point met again (a corner shared by two cells, a parent's centroid
+// that is its children's common corner) is recognized exactly.
+std::int64_t lattice_resolution(const SamplingOptions& o) { return std::int64_t{2} << std::clamp(o.max_depth, 0, 20); }
+
+int cells_for(double extent, double spacing, int lo, int hi) {
+  if (!(spacing > 0) || !std::isfinite(extent / spacing)) return lo;
+  return static_cast<int>(std::clamp(std::ceil(extent / spacing), double(lo), double(hi)));
+}
+
+double clamp_size(double l, const SamplingOptions& o) { return std::max(l, o.hmin); }
+
+// 3D extent of a face along u (or v): the longest of three iso-parametric
+// lines, each measured by a 16-segment polyline.
+double face_extent(const geom::Model& m, int face, const geom::ParamRange& pr, bool along_u) {
+  double longest = 0;
+  for (const double t : {0.0, 0.5, 1.0}) {
+    double len = 0;
+    Vec3 prev;
+    for (int k = 0; k <= 16; ++k) {
+      const double s = k / 16.0;
+      const Vec2 uv = along_u ? Vec2(pr.u0 + s * (pr.u1 - pr.u0), pr.v0 + t * (pr.v1 - pr.v0))
+                              : Vec2(pr.u0 + t * (pr.u1 - pr.u0), pr.v0 + s * (pr.v1 - pr.v0));
+      const Vec3 x = m.face_point(face, uv);
+      if (k > 0) len += (x - prev).norm();
+      prev = x;
+    }
+    longest = std::max(longest, len);
+  }
+  return longest;
+}
+
+class FaceSampler {
+ public:
+  FaceSampler(const geom::Model& m, int face, const SamplingOptions& o, SamplingStats& st)
+      : m_(m), face_(face), o_(o), st_(st), pr_(m.param_range({2, face})), res_(lattice_resolution(o)) {}
+
+  std::vector<SizeSample> run() {
+    if (!(pr_.u1 > pr_.u0) || !(pr_.v1 > pr_.v0)) return {};
+    const double spacing = 0.5 * o_.hmax;
+    nu_ = o_.grid_cells > 0 ? o_.grid_cells : cells_for(face_extent(m_, face_, pr_, true), spacing, 2, o_.max_grid_cells);
+    nv_ = o_.grid_cells > 0 ? o_.grid_cells : cells_for(face_extent(m_, face_, pr_, false), spacing, 2, o_.max_grid_cells);
+    for (int i = 0; i < nu_; ++i)
+      for (int j = 0; j < nv_; ++j) visit_cell(i * res_, j * res_, res_, 0);
+    return std::move(out_);
+  }
+
+ private:
+  struct Point {
+    Vec3 x;
+    double size;  // +inf where nothing is asked (outside the trim, flat)
+  };
+
+  Vec2 param(std::int64_t i, std::int64_t j) const {
+    return {pr_.u0 + (pr_.u1 - pr_.u0) * double(i) / double(nu_ * res_),
+            pr_.v0 + (pr_.v1 - pr_.v0) * double(j) / double(nv_ * res_)};
+  }
+
+  const Point& eval(std::int64_t i, std::int64_t j) {
+    const std::uint64_t key = (std::uint64_t(i) << 32) | std::uint64_t(j);
+    if (const auto it = seen_.find(key); it != seen_.end()) {
+      ++st_.revisited;
+      return it->second;
+    }
+    const Vec2 uv = param(i, j);
+    Point p{m_.face_point(face_, uv), std::numeric_limits<double>::infinity()};
+    if (!m_.contains_param(face_, uv)) {
+      ++st_.outside;
+    } else {
+      ++st_.evaluations;
+      const geom::Curvatures c = m_.face_curvatures(face_, uv);
+      // A pole or a singular point has no curvature to give.
+      if (std::isfinite(c.k1) && std::isfinite(c.k2)) {
+        p.size = clamp_size(surface_curvature_length(c, o_.rule), o_);
+        if (p.size < o_.hmax)
+          out_.push_back({p.x, p.size, SizeSource::kFaceCurvature, {2, face_}, uv, c.k1, c.k2, c.dir1});
+      }
+    }
+    return seen_.emplace(key, p).first->second;
+  }
+
+  void visit_cell(std::int64_t i0, std::int64_t j0, std::int64_t s, int depth) {
+    // Copies: eval() may rehash the map.
+    const Point c00 = eval(i0, j0), c10 = eval(i0 + s, j0), c01 = eval(i0, j0 + s), c11 = eval(i0 + s, j0 + s);
+    double need = std::min({c00.size, c10.size, c01.size, c11.size});
+    if (o_.centroids) need = std::min(need, eval(i0 + s / 2, j0 + s / 2).size);
+    if (!o_.adaptive || depth >= o_.max_depth || s < 2 || !std::isfinite(need)) return;
+    const double diameter = std::max((c11.x - c00.x).norm(), (c10.x - c01.x).norm());
+    if (!(need < diameter) || diameter <= o_.hmin) return;
+    ++st_.subdivided;
+    const std::int64_t h = s / 2;
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) visit_cell(i0 + a * h, j0 + b * h, h, depth + 1);
+  }
+
+  const geom::Model& m_;
+  int face_;
+  const SamplingOptions& o_;
+  SamplingStats& st_;
+  geom::ParamRange pr_;
+  std::int64_t res_;
+  int nu_ = 0, nv_ = 0;
+  std::unordered_map<std::uint64_t, Point> seen_;
+  std::vector<SizeSample> out_;
+};
+
+class EdgeSampler {
+ public:
+  EdgeSampler(const geom::Model& m, int edge, const SamplingOptions& o, SamplingStats& st)
+      : m_(m), edge_(edge), o_(o), st_(st), pr_(m.param_range({1, edge})), res_(lattice_resolution(o)) {}
+
+  std::vector<SizeSample> run() {
+    if (m_.is_degenerate(edge_) || !(pr_.u1 > pr_.u0)) return {};
+    double len = 0;
+    Vec3 prev = m_.edge_point(edge_, pr_.u0);
+    for (int k = 1; k <= 32; ++k) {
+      const Vec3 x = m_.edge_point(edge_, pr_.u0 + (pr_.u1 - pr_.u0) * k / 32.0);
+      len += (x - prev).norm();
+      prev = x;
+    }
+    n_ = o_.grid_cells > 0 ? o_.grid_cells : cells_for(len, 0.5 * o_.hmax, 4, 32 * o_.max_grid_cells);
+    for (int i = 0; i < n_; ++i) visit(i * res_, res_, 0);
+    return std::move(out_);
+  }
+
+ private:
+  struct Point {
+    Vec3 x;
+    double size;
+  };
+
+  const Point& eval(std::int64_t i) {
+    if (const auto it = seen_.find(i); it != seen_.end()) {
+      ++st_.revisited;
+      return it->second;
+    }
+    ++st_.evaluations;
+    const double u = pr_.u0 + (pr_.u1 - pr_.u0) * double(i) / double(n_ * res_);
+    const geom::CurveDerivatives d = m_.edge_derivatives(edge_, u);
+    Point p{d.point, std::numeric_limits<double>::infinity()};
+    const double k = m_.edge_curvature(edge_, u);
+    if (std::isfinite(k)) {
+      p.size = clamp_size(curvature_length(k, o_.rule), o_);
+      if (p.size < o_.hmax) {
+        const double speed = d.d1.norm();
+        out_.push_back({p.x, p.size, SizeSource::kEdgeCurvature, {1, edge_}, Vec2(u, 0), k, 0,
+                        speed > 0 ? Vec3(d.d1 / speed) : Vec3::Zero()});
+      }
+    }
+    return seen_.emplace(i, p).first->second;
+  }
+
+  void visit(std::int64_t i0, std::int64_t s, int depth) {
+    const Point a = eval(i0), b = eval(i0 + s), mid = eval(i0 + s / 2);
+    const double need = std::min({a.size, b.size, mid.size});
+    if (!o_.adaptive || depth >= o_.max_depth || s < 2 || !std::isfinite(need)) return;
+    const double chord = (b.x - a.x).norm();
+    if (!(need < chord) || chord <= o_.hmin) return;
+    ++st_.subdivided;
+    visit(i0, s / 2, depth + 1);
+    visit(i0 + s / 2, s / 2, depth + 1);
+  }
+
+  const geom::Model& m_;
+  int edge_;
+  const SamplingOptions& o_;
+  SamplingStats& st_;
+  geom::ParamRange pr_;
+  std::int64_t res_;
+  int n_ = 0;
+  std::unordered_map<std::int64_t, Point> seen_;
+  std::vector<SizeSample> out_;
+};
+
+void check_options(const SamplingOptions& o) {
+  if (!(o.hmax > 0) || !(o.hmin >= 0) || !(o.hmin <= o.hmax))
+    throw std::invalid_argument("sampling needs 0 <= hmin <= hmax and hmax > 0");
+}
+
+}  // namespace
+
+std::vector<SizeSample> sample_face_curvature(const geom::Model& model, int face, const SamplingOptions& opt,
+                                              SamplingStats* stats) {
+  check_options(opt);
+  SamplingStats local;
+  if (!opt.rule.enabled()) return {};
+  auto out = FaceSampler(model, face, opt, local).run();
+  if (stats) *stats += local;
+  return out;
+}
+
+std::vector<SizeSample> sample_edge_curvature(const geom::Model& model, int edge, const SamplingOptions& opt,
+                                              SamplingStats* stats) {
+  check_options(opt);
+  SamplingStats local;
+  if (!opt.rule.enabled()) return {};
+  auto out = EdgeSampler(model, edge, opt, local).run();
+  if (stats) *stats += local;
+  return out;
+}
+
+std::vector<SizeSample> sample_model_curvature(const geom::Model& model, const SamplingOptions& opt,
+                                               SamplingStats* stats) {
+  check_options(opt);
+  const int ne = model.count(1), nf = model.count(2);
+  std::vector<std::vector<SizeSample>> per(ne + nf);
+  std::vector<SamplingStats> st(ne + nf);
+  tbb::parallel_for(0, ne + nf, [&](int k) {
+    per[k] = k < ne ? sample_edge_curvature(model, k + 1, opt, &st[k])
+                    : sample_face_curvature(model, k - ne + 1, opt, &st[k]);
+  });
+  std::vector<SizeSample> out;
+  std::size_t total = 0;
+  for (const auto& v : per) total += v.size();
+  out.reserve(total);
+  for (int k = 0; k < ne + nf; ++k) {
+    out.insert(out.end(), per[k].begin(), per[k].end());
+    if (stats) *stats += st[k];
+  }
+  return out;
+}
+
+std::vector<SizeSample> sample_entity_size(const geom::Model& model, geom::EntityRef e, double h,
+                                           int max_points_per_direction) {
+  if (!(h > 0) || !std::isfinite(h)) throw std::invalid_argument("entity size must be finite and > 0");
+  std::vector<SizeSample> out;
+  const auto add = [&](const Vec3& x, geom::EntityRef on, const Vec2& uv) {
+    out.push_back({x, h, SizeSource::kEntitySize, on, uv, 0, 0, Vec3::Zero()});
+  };
+  const int cap = std::max(1, max_points_per_direction);
+  switch (e.dim) {
+    case 0: add(model.vertex_point(e.tag), e, Vec2::Zero()); break;
+    case 1: {
+      const geom::ParamRange pr = model.param_range(e);
+      const int n = cells_for(model.length(e.tag), 0.5 * h, 1, cap);
+      for (int i = 0; i <= n; ++i) {
+        const double u = pr.u0 + (pr.u1 - pr.u0) * i / n;
+        add(model.edge_point(e.tag, u), e, Vec2(u, 0));
+      }
+      break;
+    }
+    case 2: {
+      for (const geom::Loop& loop : model.face_loops(e.tag))
+        for (const geom::OrientedUse& use : loop.edges) {
+          auto edge_samples = sample_entity_size(model, {1, use.tag}, h, max_points_per_direction);
+          out.insert(out.end(), edge_samples.begin(), edge_samples.end());
+        }
+      const geom::ParamRange pr = model.param_range(e);
+      const int nu = cells_for(face_extent(model, e.tag, pr, true), 0.5 * h, 1, cap);
+      const int nv = cells_for(face_extent(model, e.tag, pr, false), 0.5 * h, 1, cap);
+      for (int i = 0; i <= nu; ++i)
+        for (int j = 0; j <= nv; ++j) {
+          const Vec2 uv(pr.u0 + (pr.u1 - pr.u0) * i / nu, pr.v0 + (pr.v1 - pr.v0) * j / nv);
+          if (model.contains_param(e.tag, uv)) add(model.face_point(e.tag, uv), e, uv);
+        }
+      break;
+    }
+    default:
+      throw std::invalid_argument("a size can be given on a vertex, an edge or a face (dimension 0-2)");
+  }
+  return out;
+}
+
+}  // namespace cm::size
