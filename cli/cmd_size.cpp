@@ -6,23 +6,18 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <optional>
-#include <regex>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "curvemesh/core/error.hpp"
 #include "curvemesh/core/timer.hpp"
 #include "curvemesh/geom_occ/load.hpp"
 #include "curvemesh/io/atomic_file.hpp"
 #include "curvemesh/io/formats.hpp"
-#include "curvemesh/io/mesh_io.hpp"
-#include "curvemesh/size/background_field.hpp"
 #include "curvemesh/size/build.hpp"
-#include "curvemesh/size/expression.hpp"
 #include "exit_codes.hpp"
+#include "size_options.hpp"
 
 namespace cm::cli {
 
@@ -31,65 +26,10 @@ namespace {
 struct SizeCliOptions {
   std::string model;
   std::string vtu_path, samples_path, json_path;
-  double hmax = 0, hmin = 0, hgrad = 1.3;
-  std::optional<double> curv_eps, curv_alpha;
-  bool no_curvature = false;
-  bool directional = false;
-  std::vector<std::string> entity_sizes;
-  std::vector<std::string> expressions;
-  std::string background_mesh, background_sol;
-  double heal_tolerance = 0;
-  bool no_heal = false;
+  SizeFlags size;
+  ModelFlags model_flags;
   bool quiet = false;
 };
-
-// "face:3=0.5", "edge:12=0.1", "vertex:4=0.01" or "2:3=0.5".
-std::pair<geom::EntityRef, double> parse_entity_size(const std::string& spec) {
-  static const std::regex re(R"(^\s*(vertex|edge|face|0|1|2)\s*:\s*(\d+)\s*=\s*([^\s]+)\s*$)");
-  std::smatch m;
-  if (!std::regex_match(spec, m, re))
-    throw InputError("--size", -1, -1,
-                     fmt::format("'{}': expected DIM:TAG=H with DIM vertex, edge or face (or 0, 1, 2), e.g. face:3=0.5",
-                                 spec));
-  static const std::map<std::string, int> dims = {{"vertex", 0}, {"edge", 1}, {"face", 2}, {"0", 0}, {"1", 1}, {"2", 2}};
-  double h = 0;
-  try {
-    std::size_t used = 0;
-    h = std::stod(m[3].str(), &used);
-    if (used != m[3].str().size()) throw std::invalid_argument("trailing");
-  } catch (const std::exception&) {
-    throw InputError("--size", -1, -1, fmt::format("'{}': '{}' is not a number", spec, m[3].str()));
-  }
-  if (!(h > 0) || !std::isfinite(h))
-    throw InputError("--size", -1, -1, fmt::format("'{}': the size must be finite and > 0", spec));
-  return {{dims.at(m[1].str()), std::stoi(m[2].str())}, h};
-}
-
-std::shared_ptr<const size::SizeField> read_background(const SizeCliOptions& o, double hgrad,
-                                                       std::shared_ptr<const size::SizeField>* metric) {
-  mesh::TetMesh bg = io::read_mesh(o.background_mesh);
-  const io::SolField sol = io::read_sol(io::read_file_bytes(o.background_sol), o.background_sol);
-  if (sol.num_verts() != bg.num_verts())
-    throw InputError(o.background_sol, -1, -1,
-                     fmt::format("{} values for the {} vertices of {}", sol.num_verts(), bg.num_verts(),
-                                 o.background_mesh));
-  try {
-    if (sol.type == io::SolField::Type::kScalar) {
-      // Graded with every other isotropic source in the octree.
-      return std::make_shared<size::BackgroundField>(std::move(bg), sol.values);
-    }
-    std::vector<size::Metric> ms(sol.num_verts());
-    for (std::size_t v = 0; v < ms.size(); ++v) {
-      const double* t = &sol.values[6 * v];  // MMG order m11 m12 m22 m13 m23 m33
-      ms[v] << t[0], t[1], t[3], t[1], t[2], t[4], t[3], t[4], t[5];
-    }
-    ms = size::grade_metrics(bg, std::move(ms), hgrad);
-    *metric = std::make_shared<size::BackgroundField>(std::move(bg), std::move(ms));
-    return nullptr;
-  } catch (const std::invalid_argument& e) {
-    throw InputError(o.background_sol, -1, -1, e.what());
-  }
-}
 
 void write_octree_vtu(const size::SizeOctree& tree, const std::string& path) {
   constexpr std::uint8_t kVtkVoxel = 11;  // corners x fastest, then y, then z: the octree's order
@@ -138,27 +78,8 @@ void write_samples_vtu(const std::vector<size::SizeSample>& samples, const std::
 
 int run_size(const SizeCliOptions& o) {
   Timer timer;
-  size::SizeOptions so;
-  so.hmax = o.hmax;
-  so.hmin = o.hmin;
-  so.hgrad = o.hgrad;
-  so.directional = o.directional;
-  if (o.no_curvature)
-    so.curvature = size::CurvatureRule::off();
-  else if (o.curv_eps)
-    so.curvature = size::CurvatureRule::chord_deviation(*o.curv_eps);
-  else if (o.curv_alpha)
-    so.curvature = size::CurvatureRule::relative_deviation(*o.curv_alpha);
-  for (const auto& spec : o.entity_sizes) so.entity_sizes.push_back(parse_entity_size(spec));
-  for (const auto& e : o.expressions) so.fields.push_back(size::make_expression_field(e));
-  if (!o.background_mesh.empty()) {
-    if (auto iso = read_background(o, o.hgrad, &so.metric)) so.fields.push_back(iso);
-  }
-
-  geom_occ::LoadOptions lo;
-  lo.heal = !o.no_heal;
-  lo.heal_tolerance = o.heal_tolerance;
-  const auto model = geom_occ::load_model(o.model, lo);
+  const size::SizeOptions so = make_size_options(o.size);
+  const auto model = geom_occ::load_model(o.model, o.model_flags.load_options());
   const double load_s = timer.seconds();
   const size::SizeFieldResult r = size::build_size_field(*model, so);
 
@@ -180,11 +101,8 @@ int run_size(const SizeCliOptions& o) {
   j["units"] = model->units();
   j["hmin"] = r.hmin;
   j["hmax"] = r.hmax;
-  j["hgrad"] = o.hgrad;
-  j["curvature"] = so.curvature.kind == size::CurvatureRule::Kind::kOff ? "off"
-                   : so.curvature.kind == size::CurvatureRule::Kind::kChordDeviation
-                       ? fmt::format("eps={}", so.curvature.value)
-                       : fmt::format("alpha={}", so.curvature.value);
+  j["hgrad"] = so.hgrad;
+  j["curvature"] = describe(so.curvature);
   j["samples"] = {{"evaluations", r.stats.evaluations}, {"kept", curvature_kept},
                   {"outside_trim", r.stats.outside}, {"revisited", r.stats.revisited},
                   {"subdivided_cells", r.stats.subdivided}, {"per_second", rate}};
@@ -208,7 +126,7 @@ int run_size(const SizeCliOptions& o) {
   }
   if (!o.quiet) {
     fmt::print("model: {}  (units: {})\n", o.model, model->units().empty() ? "unknown" : model->units());
-    fmt::print("  hmin {:.6g}  hmax {:.6g}  hgrad {}  curvature {}\n", r.hmin, r.hmax, o.hgrad,
+    fmt::print("  hmin {:.6g}  hmax {:.6g}  hgrad {}  curvature {}\n", r.hmin, r.hmax, so.hgrad,
                j["curvature"].get<std::string>());
     fmt::print("  curvature samples: {} evaluated ({:.3g}/s), {} ask for < hmax", r.stats.evaluations, rate,
                curvature_kept);
@@ -233,33 +151,8 @@ void add_size_command(CLI::App& app, Runner& runner) {
   cmd->add_option("-o,--output", o->vtu_path, "Write the octree cells (size, source, level) to this .vtu");
   cmd->add_option("--samples-out", o->samples_path, "Write the curvature samples (point cloud) to this .vtu");
   cmd->add_option("--json", o->json_path, "Write the summary as JSON");
-  cmd->add_option("--hmax", o->hmax, "Largest size (default: bounding-box diagonal / 20)")->check(CLI::PositiveNumber);
-  cmd->add_option("--hmin", o->hmin, "Smallest size (default: hmax / 100)")->check(CLI::PositiveNumber);
-  cmd->add_option("--hgrad", o->hgrad, "Gradation: sizes grow at most by (hgrad-1) per unit length")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 1e6));
-  auto* eps = cmd->add_option("--curv-eps", o->curv_eps,
-                              "Curvature: constant chord deviation eps (seed eq. 4.3), a length")
-                  ->check(CLI::PositiveNumber);
-  auto* alpha = cmd->add_option("--curv-alpha", o->curv_alpha,
-                                "Curvature: deviation alpha times the edge length (eq. 4.5), in (0, 0.5]; "
-                                "default 0.04")
-                    ->check(CLI::Range(1e-12, 0.5));
-  auto* off = cmd->add_flag("--no-curvature", o->no_curvature, "No curvature-based sizes");
-  eps->excludes(alpha)->excludes(off);
-  alpha->excludes(off);
-  cmd->add_flag("--directional", o->directional,
-                "Sizes along each principal direction on faces (anisotropic surface metric)");
-  cmd->add_option("--size", o->entity_sizes, "Size on a model entity: DIM:TAG=H, e.g. face:3=0.5 (repeatable)");
-  cmd->add_option("--size-expr", o->expressions,
-                  "Size as a function of x, y, z, e.g. '0.1 + 0.05*sqrt(x^2+y^2)' (repeatable)");
-  auto* bg = cmd->add_option("--background", o->background_mesh, "Background tet mesh for --background-sol");
-  auto* bgs = cmd->add_option("--background-sol", o->background_sol,
-                              "Sizes (scalar) or metrics (tensor) at the background mesh's vertices (.sol/.solb)");
-  bg->needs(bgs);
-  bgs->needs(bg);
-  cmd->add_option("--heal-tolerance", o->heal_tolerance, "Healing/sewing tolerance (0: from the model)");
-  cmd->add_flag("--no-heal", o->no_heal, "Do not run shape healing on import");
+  add_size_flags(cmd, o->size);
+  add_model_flags(cmd, o->model_flags);
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
   cmd->footer(
       "Sources are combined by taking the finest, then graded by --hgrad and clamped to [hmin, hmax].\n"

@@ -17,6 +17,8 @@ void add_check_command(CLI::App& app, Runner& runner);
 void add_info_command(CLI::App& app, Runner& runner);
 /// `curvemesh size MODEL [-o size.vtu]`
 void add_size_command(CLI::App& app, Runner& runner);
+/// `curvemesh mesh MODEL --dim 2 -o OUT`
+void add_mesh_command(CLI::App& app, Runner& runner);
 /// `curvemesh convert IN OUT`
 void add_convert_command(CLI::App& app, Runner& runner);
 

@@ -94,8 +94,8 @@ double ModelSizeField::hint_size(const SizeHint& hint) const {
   if (e.dim == 2 && e.tag >= 1 && e.tag <= model_.count(2) && hint.param.allFinite()) {
     h = face_size_[e.tag];
     if (rule_.enabled()) {
-      const geom::Curvatures c = model_.face_curvatures(e.tag, hint.param);
-      if (std::isfinite(c.k1) && std::isfinite(c.k2)) {
+      geom::Curvatures c;
+      if (usable_curvatures(model_, e.tag, hint.param, &c)) {
         // Directional: the isotropic size is the coarser principal length,
         // the finer one is in metric().
         const double l = directional_ ? std::max(curvature_length(c.k1, rule_), curvature_length(c.k2, rule_))
@@ -124,8 +124,8 @@ Metric ModelSizeField::metric(const Vec3& x, const SizeHint& hint) const {
   Metric m = isotropic_metric(std::clamp(std::min(octree_->size(x), hint_size(hint)), hmin_, hmax_));
   if (directional_ && hint.entity.dim == 2 && hint.entity.tag >= 1 && hint.entity.tag <= model_.count(2) &&
       hint.param.allFinite()) {
-    const geom::Curvatures c = model_.face_curvatures(hint.entity.tag, hint.param);
-    if (std::isfinite(c.k1) && std::isfinite(c.k2))
+    geom::Curvatures c;
+    if (usable_curvatures(model_, hint.entity.tag, hint.param, &c))
       m = intersect(m, surface_curvature_metric(c, model_.face_normal(hint.entity.tag, hint.param), rule_, hmin_,
                                                 hmax_));
   }

@@ -45,6 +45,14 @@ double surface_curvature_length(const geom::Curvatures& c, const CurvatureRule& 
   return curvature_length(std::max(std::abs(c.k1), std::abs(c.k2)), rule);
 }
 
+bool usable_curvatures(const geom::Model& model, int face, const Vec2& uv, geom::Curvatures* out) {
+  const geom::Curvatures c = model.face_curvatures(face, uv);
+  const double k = std::max(std::abs(c.k1), std::abs(c.k2));
+  if (!std::isfinite(k) || k * model.tolerance({2, face}) >= 1) return false;
+  *out = c;
+  return true;
+}
+
 int octree_level(double root_side, double length) {
   if (!(length > 0)) return std::numeric_limits<int>::max();
   if (!(length < root_side)) return 0;

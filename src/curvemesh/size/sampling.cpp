@@ -102,9 +102,9 @@ class FaceSampler {
       ++st_.outside;
     } else {
       ++st_.evaluations;
-      const geom::Curvatures c = m_.face_curvatures(face_, uv);
       // A pole or a singular point has no curvature to give.
-      if (std::isfinite(c.k1) && std::isfinite(c.k2)) {
+      geom::Curvatures c;
+      if (usable_curvatures(m_, face_, uv, &c)) {
         p.size = clamp_size(surface_curvature_length(c, o_.rule), o_);
         if (p.size < o_.hmax)
           out_.push_back({p.x, p.size, SizeSource::kFaceCurvature, {2, face_}, uv, c.k1, c.k2, c.dir1});

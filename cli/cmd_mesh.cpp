@@ -1,0 +1,125 @@
+// `curvemesh mesh MODEL --dim 2 -o out.msh`: the classified boundary mesh of a
+// model (edges discretized and faces meshed to the size field), checked
+// against the model and summarized.
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "curvemesh/core/timer.hpp"
+#include "curvemesh/geom_occ/load.hpp"
+#include "curvemesh/io/atomic_file.hpp"
+#include "curvemesh/io/mesh_io.hpp"
+#include "curvemesh/size/build.hpp"
+#include "curvemesh/generate/boundary_check.hpp"
+#include "curvemesh/generate/boundary_mesh.hpp"
+#include "exit_codes.hpp"
+#include "size_options.hpp"
+
+namespace cm::cli {
+
+namespace {
+
+struct MeshCliOptions {
+  std::string model;
+  std::string output, json_path;
+  int dim = 2;
+  SizeFlags size;
+  ModelFlags model_flags;
+  bool quiet = false;
+};
+
+int run_mesh(const MeshCliOptions& o) {
+  Timer total;
+  Timer step;
+  const size::SizeOptions so = make_size_options(o.size);
+  const auto model = geom_occ::load_model(o.model, o.model_flags.load_options());
+  const double load_s = step.seconds();
+  step.reset();
+  const size::SizeFieldResult sf = size::build_size_field(*model, so);
+  const double size_s = step.seconds();
+  generate::BoundaryMeshStats st;
+  const mesh::TetMesh m = generate::mesh_boundary(*model, *sf.field, {}, &st);
+  step.reset();
+  const generate::BoundaryReport rep = generate::check_boundary(*model, m, *sf.field);
+  const double check_s = step.seconds();
+  step.reset();
+  if (!o.output.empty()) io::write_mesh(m, o.output);
+  const double write_s = step.seconds();
+
+  const double pct_size = rep.edges ? 100.0 * rep.edges_in_range / rep.edges : 0;
+  const double pct_good = rep.triangles ? 100.0 * rep.good_triangles / rep.triangles : 0;
+  nlohmann::json j;
+  j["model"] = o.model;
+  j["dim"] = o.dim;
+  j["hmin"] = sf.hmin;
+  j["hmax"] = sf.hmax;
+  j["curvature"] = describe(so.curvature);
+  j["counts"] = {{"vertices", m.num_verts()}, {"triangles", m.tris.size()}, {"edge_segments", st.edge_segments}};
+  j["check"] = {{"valid", rep.valid()},
+                {"vertices_off_entity", rep.vertices_off_entity},
+                {"max_vertex_distance_over_tolerance", rep.max_vertex_distance},
+                {"folded_triangles", rep.folded_triangles},
+                {"open_region_edges", rep.open_region_edges},
+                {"unmeshed_faces", rep.unmeshed_faces},
+                {"problems", rep.problems}};
+  j["quality"] = {{"min", rep.min_quality},
+                  {"mean", rep.mean_quality},
+                  {"percent_at_least_0_6", pct_good},
+                  {"below_0_1", rep.poor_triangles},
+                  {"below_0_1_at_sharp_corners", rep.poor_at_sharp_corners},
+                  {"percent_edges_in_0_7_1_4", pct_size}};
+  j["operations"] = {{"insertions", st.refinement_insertions}, {"flips", st.flips}, {"smoothing", st.smoothing_moves}};
+  j["seconds"] = {{"load", load_s},          {"size_field", size_s},       {"edges", st.edges_seconds},
+                  {"faces", st.faces_seconds}, {"assembly", st.assembly_seconds}, {"check", check_s},
+                  {"write", write_s},        {"total", total.seconds()}};
+  if (!o.json_path.empty()) {
+    io::AtomicFile out(o.json_path);
+    out.write(j.dump(2));
+    out.write("\n");
+    out.commit();
+  }
+  if (!o.quiet) {
+    fmt::print("model: {}  hmin {:.4g}  hmax {:.4g}  curvature {}\n", o.model, sf.hmin, sf.hmax,
+               describe(so.curvature));
+    fmt::print("surface mesh: {} vertices, {} triangles, {} edge segments\n", m.num_verts(), m.tris.size(),
+               st.edge_segments);
+    fmt::print("quality: min {:.3f}  mean {:.3f}  {:.1f}% >= 0.6  {} below 0.1 (+{} at sharp model corners)\n",
+               rep.min_quality, rep.mean_quality, pct_good, rep.poor_triangles, rep.poor_at_sharp_corners);
+    fmt::print("sizes: {:.1f}% of edges within [0.7, 1.4] of the requested size\n", pct_size);
+    fmt::print("check: {}", rep.valid() ? "valid" : "INVALID");
+    if (!rep.valid())
+      fmt::print(" ({} vertices off their entity, {} folded triangles, {} open region edges, {} unmeshed faces)",
+                 rep.vertices_off_entity, rep.folded_triangles, rep.open_region_edges, rep.unmeshed_faces);
+    fmt::print("\n");
+    for (const auto& p : rep.problems) fmt::print("  {}\n", p);
+    fmt::print("time: load {:.2f} s, size field {:.2f} s, edges {:.2f} s, faces {:.2f} s, check {:.2f} s, "
+               "write {:.2f} s, total {:.2f} s\n",
+               load_s, size_s, st.edges_seconds, st.faces_seconds, check_s, write_s, total.seconds());
+    if (!o.output.empty()) fmt::print("wrote {}\n", o.output);
+  }
+  return rep.valid() ? kExitOk : kExitInvalidMesh;
+}
+
+}  // namespace
+
+void add_mesh_command(CLI::App& app, Runner& runner) {
+  auto o = std::make_shared<MeshCliOptions>();
+  CLI::App* cmd = app.add_subcommand("mesh", "Mesh a model: the classified surface mesh (--dim 2)");
+  cmd->add_option("model", o->model, "STEP/IGES/BREP file or builtin:NAME[:key=value,...]")->required();
+  cmd->add_option("-o,--output", o->output, "Output mesh (.msh, .mesh/.meshb, .vtu)");
+  cmd->add_option("--dim", o->dim, "Dimension of the mesh: 2 = boundary (surface) mesh")
+      ->required()
+      ->check(CLI::IsMember({2}));
+  cmd->add_option("--json", o->json_path, "Write the summary as JSON");
+  add_size_flags(cmd, o->size);
+  add_model_flags(cmd, o->model_flags);
+  cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
+  cmd->footer(
+      "Exit code 0 when the surface mesh passes its checks against the model (vertices on their\n"
+      "entities, no folded triangle, every region closed), 1 when it does not, 2 on bad input.\n"
+      "\nExamples:\n  curvemesh mesh part.step --dim 2 -o part_surface.msh\n"
+      "  curvemesh mesh builtin:torus --dim 2 --curv-eps 0.01 -o torus.vtu");
+  cmd->callback([&runner, o] { runner = [o] { return run_mesh(*o); }; });
+}
+
+}  // namespace cm::cli

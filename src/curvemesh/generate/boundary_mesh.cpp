@@ -1,0 +1,155 @@
+#include "curvemesh/generate/boundary_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include "curvemesh/core/error.hpp"
+#include "curvemesh/core/timer.hpp"
+
+namespace cm::generate {
+
+namespace {
+
+VertId add_vertex(mesh::TetMesh& m, const Vec3& x, mesh::ModelRef on, mesh::Param p = {}) {
+  m.coords.push_back(x);
+  m.vert_class.push_back(on);
+  m.vert_param.push_back(p);
+  return static_cast<VertId>(m.coords.size() - 1);
+}
+
+// Points along a degenerate (pole) edge in a face's (u, v): as many as a
+// ring of triangles around the pole needs, about six per full turn.
+int pole_points(const geom::Model& model, int face) {
+  const geom::ParamRange r = model.param_range({2, face});
+  if (r.periodic_u && r.period_u > 0) return std::clamp(int(std::lround(6 * (r.u1 - r.u0) / r.period_u)), 2, 64);
+  if (r.periodic_v && r.period_v > 0) return std::clamp(int(std::lround(6 * (r.v1 - r.v0) / r.period_v)), 2, 64);
+  return 4;
+}
+
+std::vector<std::vector<BoundaryPoint>> face_loops(const geom::Model& model, int face,
+                                                   const std::vector<EdgeMesh>& edges,
+                                                   const std::vector<std::vector<VertId>>& nodes,
+                                                   const mesh::TetMesh& m) {
+  std::vector<std::vector<BoundaryPoint>> loops;
+  for (const geom::Loop& loop : model.face_loops(face)) {
+    std::vector<BoundaryPoint> pts;
+    for (const geom::OrientedUse& use : loop.edges) {
+      const EdgeMesh& em = edges[use.tag - 1];
+      const std::vector<VertId>& ids = nodes[use.tag];
+      if (em.degenerate) {
+        const int n = pole_points(model, face);
+        for (int k = 0; k < n; ++k) {
+          const double t = double(k) / n;
+          const double u = use.forward ? em.params.front() + t * (em.params.back() - em.params.front())
+                                       : em.params.back() - t * (em.params.back() - em.params.front());
+          pts.push_back({model.edge_param_on_face(use.tag, face, u, use.forward), m.coords[ids.front()], ids.front()});
+        }
+        continue;
+      }
+      const std::size_t n = em.params.size() - 1;
+      // Each use contributes its nodes but the last, which the next use starts with.
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t i = use.forward ? k : n - k;
+        pts.push_back({model.edge_param_on_face(use.tag, face, em.params[i], use.forward), m.coords[ids[i]], ids[i]});
+      }
+    }
+    loops.push_back(std::move(pts));
+  }
+  return loops;
+}
+
+}  // namespace
+
+mesh::TetMesh mesh_boundary(const geom::Model& model, const size::SizeField& size, const BoundaryMeshOptions& o,
+                            BoundaryMeshStats* stats) {
+  BoundaryMeshStats st;
+  Timer timer;
+  const std::vector<EdgeMesh> edges = discretize_edges(model, size, o.edges);
+  st.edges_seconds = timer.seconds();
+
+  mesh::TetMesh m;
+  const int nv = model.count(0), ne = model.count(1), nf = model.count(2);
+  std::vector<VertId> vertex_of(nv + 1, kNone);
+  for (int v = 1; v <= nv; ++v) vertex_of[v] = add_vertex(m, model.vertex_point(v), {0, v});
+  std::vector<std::vector<VertId>> nodes(ne + 1);
+  for (int e = 1; e <= ne; ++e) {
+    const EdgeMesh& em = edges[e - 1];
+    const std::size_t n = em.params.size() - 1;
+    std::vector<VertId>& ids = nodes[e];
+    ids.resize(n + 1);
+    // An edge without vertices (a full circle in some kernels) gets one at u0.
+    ids.front() = em.vertices[0] > 0 ? vertex_of[em.vertices[0]]
+                                     : add_vertex(m, em.points.front(), {1, e}, {em.params.front(), std::nan("")});
+    for (std::size_t k = 1; k < n; ++k)
+      ids[k] = em.degenerate ? ids.front() : add_vertex(m, em.points[k], {1, e}, {em.params[k], std::nan("")});
+    ids.back() = em.vertices[1] > 0 ? vertex_of[em.vertices[1]] : ids.front();
+    if (em.degenerate) continue;
+    st.edge_segments += n;
+    for (std::size_t k = 0; k < n; ++k) m.edges.push_back({{ids[k], ids[k + 1]}, e});
+  }
+
+  timer.reset();
+  std::vector<FaceMesh> faces(nf);
+  std::vector<std::vector<std::vector<BoundaryPoint>>> loops(nf);
+  for (int f = 1; f <= nf; ++f) loops[f - 1] = face_loops(model, f, edges, nodes, m);
+  tbb::parallel_for(1, nf + 1, [&](int f) { faces[f - 1] = mesh_face(model, f, loops[f - 1], size, o.faces); });
+  st.faces_seconds = timer.seconds();
+
+  timer.reset();
+  for (int f = 1; f <= nf; ++f) {
+    const FaceMesh& fm = faces[f - 1];
+    std::vector<VertId> global(fm.uv.size());
+    std::size_t b = 0;
+    for (const auto& loop : loops[f - 1])
+      for (const BoundaryPoint& p : loop) global[b++] = p.vertex;
+    CM_ASSERT(b == fm.num_boundary);
+    for (std::size_t i = fm.num_boundary; i < fm.uv.size(); ++i)
+      global[i] = add_vertex(m, fm.xyz[i], {2, f}, {fm.uv[i].x(), fm.uv[i].y()});
+    // (u, v) counter-clockwise is along du × dv; the mesh follows face_normal.
+    bool reverse = false;
+    if (!fm.tris.empty()) {
+      const auto& t = fm.tris.front();
+      const Vec2 c = (fm.uv[t[0]] + fm.uv[t[1]] + fm.uv[t[2]]) / 3;
+      const geom::SurfaceDerivatives d = model.face_derivatives(f, c);
+      reverse = d.du.cross(d.dv).dot(model.face_normal(f, c)) < 0;
+    }
+    for (const auto& t : fm.tris) {
+      const VertId a = global[t[0]], bb = global[t[1]], c = global[t[2]];
+      if (a == bb || bb == c || a == c) continue;  // collapsed at a pole
+      m.tris.push_back({reverse ? std::array<VertId, 3>{a, c, bb} : std::array<VertId, 3>{a, bb, c}, f});
+    }
+    st.refinement_insertions += fm.refinement_insertions;
+    st.flips += fm.flips;
+    st.smoothing_moves += fm.smoothing_moves;
+  }
+
+  for (int v = 1; v <= nv; ++v) m.entities.push_back({0, v, {}, {}, {}});
+  for (int e = 1; e <= ne; ++e) {
+    const auto v = model.edge_vertices(e);
+    std::vector<std::int32_t> bounding;
+    if (v[0] > 0) bounding.push_back(v[0]);
+    if (v[1] > 0 && v[1] != v[0]) bounding.push_back(-v[1]);
+    m.entities.push_back({1, e, bounding, {}, {}});
+  }
+  for (int f = 1; f <= nf; ++f) {
+    std::vector<std::int32_t> bounding;
+    for (const geom::Loop& loop : model.face_loops(f))
+      for (const geom::OrientedUse& use : loop.edges)
+        if (!model.is_degenerate(use.tag)) bounding.push_back(use.forward ? use.tag : -use.tag);
+    m.entities.push_back({2, f, bounding, {}, {}});
+  }
+  for (int r = 1; r <= model.count(3); ++r) {
+    std::vector<std::int32_t> bounding;
+    for (const geom::OrientedUse& use : model.region_faces(r)) bounding.push_back(use.forward ? use.tag : -use.tag);
+    m.entities.push_back({3, r, bounding, {}, {}});
+  }
+  st.assembly_seconds = timer.seconds();
+  if (stats) *stats = st;
+  return m;
+}
+
+}  // namespace cm::generate

@@ -1,0 +1,146 @@
+// Boundary meshes: edges discretized to the size field, faces meshed in
+// (u, v), checked against the model on analytic shapes, built-in shapes and
+// every shared CAD model.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include <tbb/global_control.h>
+
+#include "curvemesh/geom/analytic_model.hpp"
+#include "curvemesh/geom_occ/load.hpp"
+#include "curvemesh/size/build.hpp"
+#include "curvemesh/generate/boundary_check.hpp"
+#include "curvemesh/generate/boundary_mesh.hpp"
+
+using namespace cm;
+
+namespace {
+
+size::SizeFieldResult field(const geom::Model& m, double hmax, double alpha = 0.04) {
+  size::SizeOptions o;
+  o.hmax = hmax;
+  o.curvature = size::CurvatureRule::relative_deviation(alpha);
+  return size::build_size_field(m, o);
+}
+
+// Geometric similarity and topological compatibility (seed §2).
+generate::BoundaryReport expect_valid(const geom::Model& model, const mesh::TetMesh& m, const size::SizeField& size,
+                                      const std::string& what) {
+  const generate::BoundaryReport r = generate::check_boundary(model, m, size);
+  EXPECT_TRUE(r.valid()) << what << ": " << (r.problems.empty() ? "" : r.problems.front());
+  EXPECT_EQ(r.vertices_off_entity, 0u) << what;
+  EXPECT_EQ(r.folded_triangles, 0u) << what;
+  EXPECT_EQ(r.open_region_edges, 0u) << what;
+  EXPECT_EQ(r.unmeshed_faces, 0u) << what;
+  EXPECT_GT(r.triangles, 0u);
+  return r;
+}
+
+// ... and the size and quality targets.
+void expect_good(const geom::Model& model, const mesh::TetMesh& m, const size::SizeField& size,
+                 const std::string& what) {
+  const generate::BoundaryReport r = expect_valid(model, m, size, what);
+  if (r.triangles == 0) return;
+  EXPECT_GE(double(r.edges_in_range) / r.edges, 0.9) << what;
+  EXPECT_GE(double(r.good_triangles) / r.triangles, 0.95) << what;
+  EXPECT_EQ(r.poor_triangles, 0u) << what << " (min quality " << r.min_quality << ")";
+}
+
+}  // namespace
+
+TEST(EdgeMesh, CircleGetsEqualSegmentsFromTheIntegral) {
+  const double radius = 2;
+  const auto cyl = geom::make_analytic_cylinder(Vec3::Zero(), Vec3::UnitZ(), radius, 1);
+  const size::UniformSizeField h(0.1);
+  int circle = 0;
+  for (int e = 1; e <= cyl->count(1); ++e)
+    if (cyl->type({1, e}) == geom::ShapeType::kCircle) circle = e;
+  ASSERT_GT(circle, 0);
+  const generate::EdgeMesh em = generate::discretize_edge(*cyl, circle, h, {});
+  const int n = static_cast<int>(std::lround(2 * std::numbers::pi * radius / 0.1));
+  ASSERT_EQ(static_cast<int>(em.params.size()), n + 1);
+  for (int k = 0; k < n; ++k) {
+    const double chord = (em.points[k + 1] - em.points[k]).norm();
+    EXPECT_NEAR(chord, 2 * radius * std::sin(std::numbers::pi / n), 1e-3 * chord);
+    EXPECT_LT(em.params[k], em.params[k + 1]);
+  }
+  // A closed edge never has fewer than three segments.
+  const size::UniformSizeField huge(100);
+  EXPECT_EQ(generate::discretize_edge(*cyl, circle, huge, {}, 3).params.size(), 4u);
+}
+
+TEST(BoundaryMesh, AnalyticShapesAreClosedValidAndWellShaped) {
+  const auto sphere = geom::make_analytic_sphere(Vec3(1, 2, 3), 2);
+  const auto cyl = geom::make_analytic_cylinder(Vec3::Zero(), Vec3(0, 1, 1), 1, 3);
+  const auto torus = geom::make_analytic_torus(Vec3::Zero(), Vec3::UnitZ(), 3, 1);
+  for (const auto* m : {sphere.get(), cyl.get(), torus.get()}) {
+    const auto sf = field(*m, 0.4);
+    const mesh::TetMesh mesh = generate::mesh_boundary(*m, *sf.field);
+    expect_good(*m, mesh, *sf.field, geom::to_string(m->type({2, 1})));
+  }
+}
+
+TEST(BoundaryMesh, BuiltinShapesAreClosedValidAndWellShaped) {
+  for (const char* spec : {"builtin:box", "builtin:cone", "builtin:part"}) {
+    const auto m = geom_occ::load_model(spec);
+    const auto sf = field(*m, m->bounding_box().diagonal() / 15);
+    expect_good(*m, generate::mesh_boundary(*m, *sf.field), *sf.field, spec);
+  }
+}
+
+TEST(BoundaryMesh, OutputDoesNotDependOnTheThreadCount) {
+  const auto m = geom_occ::load_model("builtin:part");
+  const auto sf = field(*m, 4);
+  const mesh::TetMesh parallel = generate::mesh_boundary(*m, *sf.field);
+  mesh::TetMesh serial;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    serial = generate::mesh_boundary(*m, *sf.field);
+  }
+  ASSERT_EQ(parallel.coords.size(), serial.coords.size());
+  EXPECT_EQ(parallel.coords, serial.coords);
+  ASSERT_EQ(parallel.tris.size(), serial.tris.size());
+  for (std::size_t i = 0; i < serial.tris.size(); ++i) {
+    EXPECT_EQ(parallel.tris[i].verts, serial.tris[i].verts);
+    EXPECT_EQ(parallel.tris[i].face_tag, serial.tris[i].face_tag);
+  }
+}
+
+class SharedModels : public ::testing::TestWithParam<std::string> {};
+
+// Every shared model gives a valid, closed boundary mesh; the size and
+// quality targets are met on the models listed here. Not yet on the others:
+// a few sliver triangles remain where narrow faces meet (1385_Laufrad,
+// 917_fusee, SampleCrankshaft4A, dlr_f6), and full_sphere's B-spline poles
+// give spurious curvature that over-refines around them.
+bool meets_quality_targets(const std::string& name) {
+  for (const char* ok : {"918_pump_carter_sup_21_03_2006.stp", "Torus_1.brep", "Zylkopf.stp",
+                         "metallmeister_gear.step", "ring.brep", "t20_data.step"})
+    if (name == ok) return true;
+  return false;
+}
+
+TEST_P(SharedModels, BoundaryMeshIsValidAndClosed) {
+  const auto m = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/" + GetParam());
+  const auto sf = field(*m, 0);
+  const mesh::TetMesh mesh = generate::mesh_boundary(*m, *sf.field);
+  if (meets_quality_targets(GetParam()))
+    expect_good(*m, mesh, *sf.field, GetParam());
+  else
+    expect_valid(*m, mesh, *sf.field, GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, SharedModels,
+                         ::testing::Values("1385_Laufrad_1000.stp", "917_fusee.stp",
+                                           "918_pump_carter_sup_21_03_2006.stp", "SampleCrankshaft4A.stp",
+                                           "Torus_1.brep", "Zylkopf.stp", "dlr_f6.brep", "full_sphere.brep",
+                                           "metallmeister_gear.step", "ring.brep", "t20_data.step"),
+                         [](const auto& param_info) {
+                           std::string n = param_info.param;
+                           for (char& c : n)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return n;
+                         });
