@@ -67,6 +67,7 @@ int run_mesh(const MeshCliOptions& o) {
                   {"percent_at_least_0_6", pct_good},
                   {"below_0_1", rep.poor_triangles},
                   {"below_0_1_at_sharp_corners", rep.poor_at_sharp_corners},
+                  {"below_0_1_at_small_features", rep.poor_at_small_features},
                   {"percent_edges_in_0_7_1_4", pct_size}};
   j["operations"] = {{"insertions", st.refinement_insertions}, {"flips", st.flips}, {"smoothing", st.smoothing_moves}};
   j["seconds"] = {{"load", load_s},          {"size_field", size_s},       {"edges", st.edges_seconds},
@@ -83,8 +84,10 @@ int run_mesh(const MeshCliOptions& o) {
                describe(so.curvature));
     fmt::print("surface mesh: {} vertices, {} triangles, {} edge segments\n", m.num_verts(), m.tris.size(),
                st.edge_segments);
-    fmt::print("quality: min {:.3f}  mean {:.3f}  {:.1f}% >= 0.6  {} below 0.1 (+{} at sharp model corners)\n",
-               rep.min_quality, rep.mean_quality, pct_good, rep.poor_triangles, rep.poor_at_sharp_corners);
+    fmt::print("quality: min {:.3f}  mean {:.3f}  {:.1f}% >= 0.6  {} below 0.1 (+{} at sharp model corners, +{} at "
+               "model features below hmin)\n",
+               rep.min_quality, rep.mean_quality, pct_good, rep.poor_triangles, rep.poor_at_sharp_corners,
+               rep.poor_at_small_features);
     fmt::print("sizes: {:.1f}% of edges within [0.7, 1.4] of the requested size\n", pct_size);
     fmt::print("check: {}", rep.valid() ? "valid" : "INVALID");
     if (!rep.valid())

@@ -52,7 +52,7 @@ BoundaryReport check_boundary(const geom::Model& model, const mesh::TetMesh& m, 
   // Triangles: fold against the surface, quality, corners.
   r.triangles = m.tris.size();
   std::vector<double> q(m.tris.size());
-  std::atomic<std::size_t> folded{0}, poor{0}, poor_sharp{0};
+  std::atomic<std::size_t> folded{0}, poor{0}, poor_sharp{0}, poor_small{0};
   tbb::parallel_for(std::size_t{0}, m.tris.size(), [&](std::size_t i) {
     const auto& t = m.tris[i];
     const Vec3 a = m.coords[t.verts[0]], b = m.coords[t.verts[1]], c = m.coords[t.verts[2]];
@@ -75,12 +75,15 @@ BoundaryReport check_boundary(const geom::Model& model, const mesh::TetMesh& m, 
         const double cosine = (p1 - p0).normalized().dot((p2 - p0).normalized());
         if (cosine > std::cos(std::numbers::pi / 6)) sharp = true;
       }
-      ++(sharp ? poor_sharp : poor);
+      const double shortest = std::min({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      const bool small = shortest < 0.1 * size.size((a + b + c) / 3);
+      ++(sharp ? poor_sharp : small ? poor_small : poor);
     }
   });
   r.folded_triangles = folded;
   r.poor_triangles = poor;
   r.poor_at_sharp_corners = poor_sharp;
+  r.poor_at_small_features = poor_small;
   if (!q.empty()) {
     r.min_quality = *std::min_element(q.begin(), q.end());
     double sum = 0;

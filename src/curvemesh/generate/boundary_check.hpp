@@ -26,6 +26,9 @@ struct BoundaryReport {
   std::size_t good_triangles = 0;       ///< mean ratio >= 0.6
   std::size_t poor_triangles = 0;       ///< mean ratio < 0.1, away from sharp model corners
   std::size_t poor_at_sharp_corners = 0;///< mean ratio < 0.1 with a corner where model edges meet at < 30°
+  /// mean ratio < 0.1 with an edge under a tenth of the size: a model feature
+  /// (a sliver face, a tiny edge) below hmin, which the mesh cannot resolve
+  std::size_t poor_at_small_features = 0;
   std::vector<std::string> problems;    ///< first few failures, human-readable
 
   bool valid() const { return vertices_off_entity == 0 && folded_triangles == 0 && open_region_edges == 0 && unmeshed_faces == 0; }

@@ -50,6 +50,24 @@ SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& o)
     });
     for (const auto& v : per) r.samples.insert(r.samples.end(), v.begin(), v.end());
   }
+  if (o.short_edges) {
+    const int ne = model.count(1);
+    std::vector<std::vector<SizeSample>> per(ne);
+    tbb::parallel_for(1, ne + 1, [&](int e) {
+      if (model.is_degenerate(e)) return;
+      const double length = model.length(e);
+      if (!(length < r.hmax)) return;
+      per[e - 1] = sample_entity_size(model, {1, e}, std::max(length, r.hmin));
+      for (SizeSample& s : per[e - 1]) s.source = SizeSource::kShortEdge;
+    });
+    for (const auto& v : per) r.samples.insert(r.samples.end(), v.begin(), v.end());
+  }
+  if (o.narrow_faces) {
+    const int nf = model.count(2);
+    std::vector<std::vector<SizeSample>> per(nf);
+    tbb::parallel_for(1, nf + 1, [&](int f) { per[f - 1] = sample_face_proximity(model, f, r.hmin, r.hmax); });
+    for (const auto& v : per) r.samples.insert(r.samples.end(), v.begin(), v.end());
+  }
   r.sampling_seconds = timer.seconds();
 
   Timer octree_timer;

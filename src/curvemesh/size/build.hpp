@@ -36,6 +36,13 @@ struct SizeOptions {
   /// so it does not undo the anisotropy, and metric() with a face hint
   /// intersects it with the surface metric.
   bool directional = false;
+  /// A model edge shorter than hmax asks for its own length along it, so the
+  /// sizes around it grade down to it instead of leaving slivers between it
+  /// and its longer neighbours.
+  bool short_edges = true;
+  /// A face narrower than the size (two of its boundary edges that share no
+  /// vertex closer than hmax) asks for its width there.
+  bool narrow_faces = true;
 };
 
 /// The field meshers query: the graded octree everywhere; at a point given

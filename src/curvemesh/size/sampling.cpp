@@ -17,6 +17,8 @@ const char* to_string(SizeSource s) {
     case SizeSource::kField: return "size field";
     case SizeSource::kGradation: return "gradation";
     case SizeSource::kHmin: return "hmin";
+    case SizeSource::kShortEdge: return "short edge";
+    case SizeSource::kProximity: return "narrow face";
   }
   return "?";
 }
@@ -250,6 +252,47 @@ std::vector<SizeSample> sample_model_curvature(const geom::Model& model, const S
   for (int k = 0; k < ne + nf; ++k) {
     out.insert(out.end(), per[k].begin(), per[k].end());
     if (stats) *stats += st[k];
+  }
+  return out;
+}
+
+std::vector<SizeSample> sample_face_proximity(const geom::Model& model, int face, double hmin, double hmax) {
+  std::vector<int> edges;
+  for (const geom::Loop& loop : model.face_loops(face))
+    for (const geom::OrientedUse& use : loop.edges)
+      if (!model.is_degenerate(use.tag)) edges.push_back(use.tag);
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<SizeSample> out;
+  if (edges.size() < 2) return out;
+  const auto touches = [&](int a, int b) {
+    const auto va = model.edge_vertices(a), vb = model.edge_vertices(b);
+    for (const int x : va)
+      for (const int y : vb)
+        if (x > 0 && x == y) return true;
+    return false;
+  };
+  for (const int e : edges) {
+    std::vector<int> others;
+    for (const int e2 : edges)
+      if (e2 != e && !touches(e, e2)) others.push_back(e2);
+    if (others.empty()) continue;
+    const geom::ParamRange r = model.param_range({1, e});
+    const int n = cells_for(model.length(e), 0.25 * hmax, 4, 256);
+    for (int i = 0; i <= n; ++i) {
+      const double u = r.u0 + (r.u1 - r.u0) * i / n;
+      const Vec3 x = model.edge_point(e, u);
+      double d = hmax;
+      for (const int e2 : others) {
+        // Cheap rejection before the projection.
+        const geom::BoundingBox b = model.bounding_box({1, e2});
+        const Vec3 gap = (b.min - x).cwiseMax(x - b.max).cwiseMax(0.0);
+        if (gap.norm() >= d) continue;
+        d = std::min(d, model.closest_point({1, e2}, x).distance);
+      }
+      if (d < hmax)
+        out.push_back({x, std::max(d, hmin), SizeSource::kProximity, {1, e}, Vec2(u, 0), 0, 0, Vec3::Zero()});
+    }
   }
   return out;
 }

@@ -28,6 +28,8 @@ enum class SizeSource : int {
   kField = 4,           ///< analytic or background field
   kGradation = 5,       ///< a finer size nearby, spread by --hgrad
   kHmin = 6,            ///< clamped up to hmin
+  kShortEdge = 7,       ///< a model edge shorter than the size around it
+  kProximity = 8,       ///< two boundary edges of a narrow face close to each other
 };
 const char* to_string(SizeSource s);
 
@@ -70,6 +72,12 @@ std::vector<SizeSample> sample_edge_curvature(const geom::Model& model, int edge
 /// Every face and edge, in parallel; deterministic order (edges, then faces, by tag).
 std::vector<SizeSample> sample_model_curvature(const geom::Model& model, const SamplingOptions& opt,
                                                SamplingStats* stats = nullptr);
+
+/// Narrow faces: points along each boundary edge of `face` asking for their
+/// distance to the nearest other boundary edge of the face that shares no
+/// vertex with it, where that distance is below hmax (so a strip between two
+/// nearly parallel edges gets elements as small as it is wide).
+std::vector<SizeSample> sample_face_proximity(const geom::Model& model, int face, double hmin, double hmax);
 
 /// Points covering a vertex, edge or face (spacing <= h/2, at most
 /// max_points_per_direction per parameter direction), each with size h.

@@ -1,0 +1,117 @@
+// Boundary (surface) meshing of every shared model with the default sizes
+// (hmax = diagonal / 20, hmin = hmax / 100, curvature alpha = 0.04, about 20
+// edges per circle), side by side with `gmsh -2` given the same sizes
+// (MeshSizeMax, MeshSizeMin, MeshSizeFromCurvature 20) when Gmsh is
+// installed. Prints one line per model: triangles, wall time, min and mean
+// triangle mean ratio for both, and Gmsh's time over ours. Our time includes
+// the size field (curvature sampling, octree) and the checks are not timed.
+// Models are read from $CM_MODELS_DIR, by default ../../shared/models.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "curvemesh/generate/boundary_mesh.hpp"
+#include "curvemesh/geom_occ/load.hpp"
+#include "curvemesh/io/atomic_file.hpp"
+#include "curvemesh/io/formats.hpp"
+#include "curvemesh/quality/measures.hpp"
+#include "curvemesh/size/build.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path models_dir() {
+  if (const char* dir = std::getenv("CM_MODELS_DIR")) return dir;
+  return fs::path(__FILE__).parent_path() / ".." / ".." / "shared" / "models";
+}
+
+struct Row {
+  std::size_t triangles = 0;
+  double seconds = 0, min_q = 0, mean_q = 0;
+  bool ok = false;
+};
+
+void measure(const cm::mesh::TetMesh& m, Row& r) {
+  r.triangles = m.tris.size();
+  double sum = 0, lo = 1;
+  for (const auto& t : m.tris) {
+    const double q = cm::quality::triangle_mean_ratio(m.coords[t.verts[0]], m.coords[t.verts[1]], m.coords[t.verts[2]]);
+    sum += q;
+    lo = std::min(lo, q);
+  }
+  r.min_q = lo;
+  r.mean_q = m.tris.empty() ? 0 : sum / m.tris.size();
+}
+
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+int main() {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(models_dir(), ec)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext == ".step" || ext == ".stp" || ext == ".brep") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  const bool have_gmsh = std::system("gmsh --version > /dev/null 2>&1") == 0;
+  const fs::path tmp = fs::temp_directory_path() / "curvemesh_bench_surface";
+  fs::create_directories(tmp);
+  fmt::print("{:<36} {:>9} {:>8} {:>6} {:>6} | {:>9} {:>8} {:>6} {:>6} | {:>7}\n", "model", "tris", "s", "minq",
+             "meanq", "gmsh tris", "s", "minq", "meanq", "gmsh/us");
+  for (const fs::path& f : files) {
+    Row ours, theirs;
+    double hmin = 0, hmax = 0;
+    try {
+      const auto model = cm::geom_occ::load_model(f.string());
+      const double t0 = now();
+      const cm::size::SizeFieldResult sf = cm::size::build_size_field(*model, {});
+      const cm::mesh::TetMesh m = cm::generate::mesh_boundary(*model, *sf.field);
+      ours.seconds = now() - t0;
+      ours.ok = true;
+      hmin = sf.hmin;
+      hmax = sf.hmax;
+      measure(m, ours);
+    } catch (const std::exception& e) {
+      fmt::print("{:<36} error: {}\n", f.filename().string(), e.what());
+      continue;
+    }
+    if (have_gmsh) {
+      const fs::path out = tmp / (f.stem().string() + "_gmsh.msh");
+      const std::string cmd = fmt::format(
+          "gmsh -2 '{}' -o '{}' -format msh41 -setnumber Mesh.MeshSizeMax {} -setnumber Mesh.MeshSizeMin {} "
+          "-setnumber Mesh.MeshSizeFromCurvature 20 -setnumber General.Verbosity 0 > /dev/null 2>&1",
+          f.string(), out.string(), hmax, hmin);
+      const double t0 = now();
+      const int rc = std::system(cmd.c_str());
+      theirs.seconds = now() - t0;
+      if (rc == 0) {
+        try {
+          measure(cm::io::read_msh(cm::io::read_file_bytes(out.string()), out.string()), theirs);
+          theirs.ok = true;
+        } catch (const std::exception&) {
+        }
+      }
+    }
+    fmt::print("{:<36} {:>9} {:>8.3f} {:>6.3f} {:>6.3f} | ", f.filename().string(), ours.triangles, ours.seconds,
+               ours.min_q, ours.mean_q);
+    if (theirs.ok)
+      fmt::print("{:>9} {:>8.3f} {:>6.3f} {:>6.3f} | {:>7.2f}\n", theirs.triangles, theirs.seconds, theirs.min_q,
+                 theirs.mean_q, theirs.seconds / ours.seconds);
+    else
+      fmt::print("{:>9}\n", have_gmsh ? "gmsh failed" : "no gmsh");
+    std::fflush(stdout);  // a line per model as it finishes
+  }
+  fs::remove_all(tmp);
+  return 0;
+}
