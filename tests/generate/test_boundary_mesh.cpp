@@ -111,20 +111,14 @@ TEST(BoundaryMesh, OutputDoesNotDependOnTheThreadCount) {
 
 class SharedModels : public ::testing::TestWithParam<std::string> {};
 
-// Every shared model gives a valid, closed boundary mesh, and all but one
-// meet the size and quality targets (slivers forced by sharp model corners or
-// by model features below hmin are counted apart). Not yet full_sphere: its
-// B-spline poles give spurious curvature that over-refines around them.
-bool meets_quality_targets(const std::string& name) { return name != "full_sphere.brep"; }
-
-TEST_P(SharedModels, BoundaryMeshIsValidAndClosed) {
+// Every shared model gives a valid, closed boundary mesh that meets the size
+// and quality targets (slivers forced by sharp model corners or by model
+// features below hmin are counted apart).
+TEST_P(SharedModels, BoundaryMeshIsValidClosedAndWellShaped) {
   const auto m = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/" + GetParam());
   const auto sf = field(*m, 0);
   const mesh::TetMesh mesh = generate::mesh_boundary(*m, *sf.field);
-  if (meets_quality_targets(GetParam()))
-    expect_good(*m, mesh, *sf.field, GetParam());
-  else
-    expect_valid(*m, mesh, *sf.field, GetParam());
+  expect_good(*m, mesh, *sf.field, GetParam());
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, SharedModels,

@@ -43,12 +43,12 @@ double curvature_length(double kappa, const CurvatureRule& rule);
 /// Requested length at a face point: from R = 1 / max(|κ₁|, |κ₂|).
 double surface_curvature_length(const geom::Curvatures& c, const CurvatureRule& rule);
 
-/// The principal curvatures at (u, v) when they mean something: finite, and
-/// with radii above the face's tolerance. At a singular point of the
-/// parametrization (the pole of a B-spline sphere, a cone's apex evaluated
-/// exactly) kernels return huge or infinite values that are artefacts of
-/// du × dv vanishing; a radius below the model tolerance cannot be meshed
-/// anyway. Returns false for those.
+/// The principal curvatures at (u, v) when they mean something: at a regular
+/// point of the parametrization (|du × dv| > 1e-8 (|du|² + |dv|²)), finite,
+/// and with radii above the face's tolerance. At a singular point (the pole
+/// of a B-spline sphere, a cone's apex) kernels return arbitrary values that
+/// are artefacts of du × dv vanishing; a radius below the model tolerance
+/// cannot be meshed anyway. Returns false for those.
 bool usable_curvatures(const geom::Model& model, int face, const Vec2& uv, geom::Curvatures* out);
 
 /// Octree level of eq. 4.6 for a length ℓ in a root cube of side L:
