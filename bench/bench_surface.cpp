@@ -5,7 +5,7 @@
 // installed. Prints one line per model: triangles, wall time, min and mean
 // triangle mean ratio for both, and Gmsh's time over ours. Our time includes
 // the size field (curvature sampling, octree) and the checks are not timed.
-// Models are read from $CM_MODELS_DIR, by default ../../shared/models.
+// Gmsh is stopped after kGmshSeconds. Models are read from $CM_MODELS_DIR, by default ../../shared/models.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -50,6 +50,9 @@ void measure(const cm::mesh::TetMesh& m, Row& r) {
   r.mean_q = m.tris.empty() ? 0 : sum / m.tris.size();
 }
 
+// Gmsh gets this long per model (it can spend many minutes on sliver faces).
+constexpr int kGmshSeconds = 300;
+
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -89,9 +92,9 @@ int main() {
     if (have_gmsh) {
       const fs::path out = tmp / (f.stem().string() + "_gmsh.msh");
       const std::string cmd = fmt::format(
-          "gmsh -2 '{}' -o '{}' -format msh41 -setnumber Mesh.MeshSizeMax {} -setnumber Mesh.MeshSizeMin {} "
+          "timeout {} gmsh -2 '{}' -o '{}' -format msh41 -setnumber Mesh.MeshSizeMax {} -setnumber Mesh.MeshSizeMin {} "
           "-setnumber Mesh.MeshSizeFromCurvature 20 -setnumber General.Verbosity 0 > /dev/null 2>&1",
-          f.string(), out.string(), hmax, hmin);
+          kGmshSeconds, f.string(), out.string(), hmax, hmin);
       const double t0 = now();
       const int rc = std::system(cmd.c_str());
       theirs.seconds = now() - t0;
@@ -109,7 +112,7 @@ int main() {
       fmt::print("{:>9} {:>8.3f} {:>6.3f} {:>6.3f} | {:>7.2f}\n", theirs.triangles, theirs.seconds, theirs.min_q,
                  theirs.mean_q, theirs.seconds / ours.seconds);
     else
-      fmt::print("{:>9}\n", have_gmsh ? "gmsh failed" : "no gmsh");
+      fmt::print("{:>9}\n", !have_gmsh ? "no gmsh" : theirs.seconds >= kGmshSeconds ? "gmsh timed out" : "gmsh failed");
     std::fflush(stdout);  // a line per model as it finishes
   }
   fs::remove_all(tmp);
