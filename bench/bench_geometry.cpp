@@ -14,17 +14,13 @@
 #include <vector>
 
 #include "curvemesh/geom_occ/load.hpp"
+#include "shared_models.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using cm::Vec2;
 using cm::Vec3;
-
-fs::path models_dir() {
-  if (const char* dir = std::getenv("CM_MODELS_DIR")) return dir;
-  return fs::path(__FILE__).parent_path() / ".." / ".." / "shared" / "models";
-}
 
 // t20_data.step with its largest B-spline face, loaded once for all cases.
 struct FreeformFace {
@@ -37,7 +33,7 @@ struct FreeformFace {
 const FreeformFace& freeform_face() {
   static const FreeformFace data = [] {
     FreeformFace d;
-    d.model = cm::geom_occ::load_model((models_dir() / "t20_data.step").string());
+    d.model = cm::geom_occ::load_model((cm::bench::models_dir() / "t20_data.step").string());
     double best_area = 0;
     for (int f = 1; f <= d.model->count(2); ++f) {
       if (d.model->type({2, f}) != cm::geom::ShapeType::kBSplineSurface) continue;
@@ -127,13 +123,7 @@ void BM_Load(benchmark::State& state, const std::string& path) {
 
 // One load case per shared model, named after the file.
 const int kRegistered = [] {
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(models_dir(), ec)) {
-    const std::string ext = entry.path().extension().string();
-    if (ext == ".step" || ext == ".stp" || ext == ".brep") files.push_back(entry.path());
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = cm::bench::model_files();
   for (const fs::path& f : files) {
     benchmark::RegisterBenchmark(("BM_Load/" + f.filename().string()).c_str(), BM_Load, f.string())
         ->Unit(benchmark::kMillisecond)

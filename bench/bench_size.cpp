@@ -16,16 +16,12 @@
 #include <vector>
 
 #include "curvemesh/geom_occ/load.hpp"
+#include "shared_models.hpp"
 #include "curvemesh/size/build.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path models_dir() {
-  if (const char* dir = std::getenv("CM_MODELS_DIR")) return dir;
-  return fs::path(__FILE__).parent_path() / ".." / ".." / "shared" / "models";
-}
 
 void BM_SizeField(benchmark::State& state, const std::string& path) {
   const auto model = cm::geom_occ::load_model(path);
@@ -50,13 +46,7 @@ void BM_SizeField(benchmark::State& state, const std::string& path) {
 }
 
 const int kRegistered = [] {
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(models_dir(), ec)) {
-    const std::string ext = entry.path().extension().string();
-    if (ext == ".step" || ext == ".stp" || ext == ".brep") files.push_back(entry.path());
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = cm::bench::model_files();
   for (const fs::path& f : files)
     benchmark::RegisterBenchmark(("BM_SizeField/" + f.filename().string()).c_str(), BM_SizeField, f.string())
         ->Unit(benchmark::kMillisecond)

@@ -18,6 +18,7 @@
 
 #include "curvemesh/generate/boundary_mesh.hpp"
 #include "curvemesh/geom_occ/load.hpp"
+#include "shared_models.hpp"
 #include "curvemesh/io/atomic_file.hpp"
 #include "curvemesh/io/formats.hpp"
 #include "curvemesh/quality/measures.hpp"
@@ -26,11 +27,6 @@
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path models_dir() {
-  if (const char* dir = std::getenv("CM_MODELS_DIR")) return dir;
-  return fs::path(__FILE__).parent_path() / ".." / ".." / "shared" / "models";
-}
 
 struct Row {
   std::size_t triangles = 0;
@@ -60,13 +56,7 @@ double now() {
 }  // namespace
 
 int main() {
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(models_dir(), ec)) {
-    const std::string ext = entry.path().extension().string();
-    if (ext == ".step" || ext == ".stp" || ext == ".brep") files.push_back(entry.path());
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = cm::bench::model_files();
   const bool have_gmsh = std::system("gmsh --version > /dev/null 2>&1") == 0;
   const fs::path tmp = fs::temp_directory_path() / "curvemesh_bench_surface";
   fs::create_directories(tmp);

@@ -12,7 +12,6 @@
 #include "commands.hpp"
 #include "curvemesh/core/progress.hpp"
 #include "curvemesh/core/timer.hpp"
-#include "curvemesh/io/atomic_file.hpp"
 #include "curvemesh/io/mesh_io.hpp"
 #include "curvemesh/mesh/validate.hpp"
 #include "curvemesh/quality/bezier_jacobian.hpp"
@@ -20,6 +19,7 @@
 #include "curvemesh/quality/shape_measure.hpp"
 #include "curvemesh/quality/statistics.hpp"
 #include "exit_codes.hpp"
+#include "json_output.hpp"
 
 namespace cm::cli {
 
@@ -209,10 +209,7 @@ int run_check(const CheckOptions& o) {
                     {"radius_ratio", stats_json(rr_stats)},
                     {"edge_length", stats_json(len_stats)}};
     j["seconds"] = {{"read", read_s}, {"validate", validate_s}, {"quality", quality_s}};
-    io::AtomicFile out(o.json_path);
-    out.write(j.dump(2));
-    out.write("\n");
-    out.commit();
+    write_json(j, o.json_path);
   }
   return valid ? kExitOk : kExitInvalidMesh;
 }

@@ -10,8 +10,8 @@
 #include "commands.hpp"
 #include "curvemesh/core/timer.hpp"
 #include "curvemesh/geom_occ/load.hpp"
-#include "curvemesh/io/atomic_file.hpp"
 #include "exit_codes.hpp"
+#include "json_output.hpp"
 
 namespace cm::cli {
 
@@ -117,10 +117,7 @@ int run_info(const InfoOptions& o) {
   fmt::print("time: load {:.2f} s, total {:.2f} s\n", load_s, timer.seconds());
 
   if (!o.json_path.empty()) {
-    io::AtomicFile out(o.json_path);
-    out.write(j.dump(2));
-    out.write("\n");
-    out.commit();
+    write_json(j, o.json_path);
   }
   return kExitOk;
 }

@@ -7,12 +7,12 @@
 #include "commands.hpp"
 #include "curvemesh/core/timer.hpp"
 #include "curvemesh/geom_occ/load.hpp"
-#include "curvemesh/io/atomic_file.hpp"
 #include "curvemesh/io/mesh_io.hpp"
 #include "curvemesh/size/build.hpp"
 #include "curvemesh/generate/boundary_check.hpp"
 #include "curvemesh/generate/boundary_mesh.hpp"
 #include "exit_codes.hpp"
+#include "json_output.hpp"
 #include "size_options.hpp"
 
 namespace cm::cli {
@@ -74,10 +74,7 @@ int run_mesh(const MeshCliOptions& o) {
                   {"faces", st.faces_seconds}, {"assembly", st.assembly_seconds}, {"check", check_s},
                   {"write", write_s},        {"total", total.seconds()}};
   if (!o.json_path.empty()) {
-    io::AtomicFile out(o.json_path);
-    out.write(j.dump(2));
-    out.write("\n");
-    out.commit();
+    write_json(j, o.json_path);
   }
   if (!o.quiet) {
     fmt::print("model: {}  hmin {:.4g}  hmax {:.4g}  curvature {}\n", o.model, sf.hmin, sf.hmax,

@@ -13,10 +13,10 @@
 #include "commands.hpp"
 #include "curvemesh/core/timer.hpp"
 #include "curvemesh/geom_occ/load.hpp"
-#include "curvemesh/io/atomic_file.hpp"
 #include "curvemesh/io/formats.hpp"
 #include "curvemesh/size/build.hpp"
 #include "exit_codes.hpp"
+#include "json_output.hpp"
 #include "size_options.hpp"
 
 namespace cm::cli {
@@ -119,10 +119,7 @@ int run_size(const SizeCliOptions& o) {
   if (!o.vtu_path.empty()) write_octree_vtu(*r.octree, o.vtu_path);
   if (!o.samples_path.empty()) write_samples_vtu(r.samples, o.samples_path);
   if (!o.json_path.empty()) {
-    io::AtomicFile out(o.json_path);
-    out.write(j.dump(2));
-    out.write("\n");
-    out.commit();
+    write_json(j, o.json_path);
   }
   if (!o.quiet) {
     fmt::print("model: {}  (units: {})\n", o.model, model->units().empty() ? "unknown" : model->units());
