@@ -1,6 +1,6 @@
-// `curvemesh mesh MODEL --dim 2 -o out.msh`: the classified boundary mesh of a
-// model (edges discretized and faces meshed to the size field), checked
-// against the model and summarized.
+// `curvemesh mesh MODEL -o out.msh`: the volume mesh of a model (the main
+// job), or with --dim 2 its classified boundary mesh; checked against the
+// model and summarized.
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -11,6 +11,10 @@
 #include "curvemesh/size/build.hpp"
 #include "curvemesh/generate/boundary_check.hpp"
 #include "curvemesh/generate/boundary_mesh.hpp"
+#include "curvemesh/generate/volume_mesh.hpp"
+#include "curvemesh/mesh/validate.hpp"
+#include "curvemesh/quality/measures.hpp"
+#include "curvemesh/quality/statistics.hpp"
 #include "exit_codes.hpp"
 #include "json_output.hpp"
 #include "size_options.hpp"
@@ -22,13 +26,16 @@ namespace {
 struct MeshCliOptions {
   std::string model;
   std::string output, json_path;
-  int dim = 2;
+  int dim = 3;
   SizeFlags size;
   ModelFlags model_flags;
   bool quiet = false;
 };
 
+int run_volume(const MeshCliOptions& o);
+
 int run_mesh(const MeshCliOptions& o) {
+  if (o.dim == 3) return run_volume(o);
   Timer total;
   Timer step;
   const size::SizeOptions so = make_size_options(o.size);
@@ -100,24 +107,135 @@ int run_mesh(const MeshCliOptions& o) {
   return rep.valid() ? kExitOk : kExitInvalidMesh;
 }
 
+// Model volume (sum over regions) and mesh volume, for the summary.
+std::pair<double, double> volumes(const geom::Model& model, const mesh::TetMesh& m) {
+  double vm = 0, vmesh = 0;
+  for (int r = 1; r <= model.count(3); ++r) vm += model.volume(r);
+  for (TetId t = 0; t < m.num_tets(); ++t) vmesh += mesh::tet_volume(m, t);
+  return {vm, vmesh};
+}
+
+int run_volume(const MeshCliOptions& o) {
+  Timer total;
+  Timer step;
+  const size::SizeOptions so = make_size_options(o.size);
+  const auto model = geom_occ::load_model(o.model, o.model_flags.load_options());
+  const double load_s = step.seconds();
+  step.reset();
+  const size::SizeFieldResult sf = size::build_size_field(*model, so);
+  const double size_s = step.seconds();
+  generate::VolumeMeshStats st;
+  const mesh::TetMesh m = generate::mesh_volume(*model, *sf.field, {}, &st);
+  step.reset();
+  const auto valid = mesh::validate(m, mesh::Level::kFull);
+  const generate::BoundaryReport rep = generate::check_boundary(*model, m, *sf.field);
+  const std::size_t nt = m.num_tets();
+  std::vector<double> q(nt), dmin(nt);
+  for (TetId t = 0; t < nt; ++t) {
+    const auto e = quality::evaluate_tet(m, t);
+    q[t] = e.mean_ratio;
+    dmin[t] = e.min_dihedral;
+  }
+  const auto qs = quality::compute_statistics(q);
+  const auto ds = quality::compute_statistics(dmin);
+  const auto [vol_model, vol_mesh] = volumes(*model, m);
+  const double check_s = step.seconds();
+  step.reset();
+  if (!o.output.empty()) io::write_mesh(m, o.output);
+  const double write_s = step.seconds();
+  const bool ok = valid.valid() && rep.vertices_off_entity == 0 && rep.folded_triangles == 0;
+  const std::size_t steiner = st.recovery.steiner_on_edges + st.recovery.steiner_on_faces;
+
+  nlohmann::json j;
+  j["model"] = o.model;
+  j["dim"] = 3;
+  j["hmin"] = sf.hmin;
+  j["hmax"] = sf.hmax;
+  j["curvature"] = describe(so.curvature);
+  j["counts"] = {{"vertices", m.num_verts()},
+                 {"tets", nt},
+                 {"boundary_triangles", m.tris.size()},
+                 {"boundary_vertices_initial", st.boundary_vertices},
+                 {"interior_points", st.interior_points},
+                 {"refused_points", st.refused_points}};
+  j["recovery"] = {{"missing_edges", st.recovery.missing_edges_initial},
+                   {"missing_triangles", st.recovery.missing_triangles_initial},
+                   {"steiner_on_model_edges", st.recovery.steiner_on_edges},
+                   {"steiner_on_model_faces", st.recovery.steiner_on_faces},
+                   {"rounds", st.recovery.rounds},
+                   {"region_conflicts", st.region_conflicts}};
+  j["check"] = {{"valid", ok},
+                {"issues", valid.num_issues},
+                {"inverted", valid.num_inverted},
+                {"flat", valid.num_flat},
+                {"nonconforming", valid.num_nonconforming},
+                {"classification", valid.num_classification},
+                {"vertices_off_entity", rep.vertices_off_entity},
+                {"folded_triangles", rep.folded_triangles}};
+  j["volume"] = {{"model", vol_model}, {"mesh", vol_mesh}};
+  j["quality"] = {{"mean_ratio_min", qs.min},
+                  {"mean_ratio_mean", qs.mean},
+                  {"min_dihedral_deg", ds.min},
+                  {"surface_min", rep.min_quality},
+                  {"surface_mean", rep.mean_quality}};
+  j["seconds"] = {{"load", load_s},
+                  {"size_field", size_s},
+                  {"boundary", st.boundary_seconds},
+                  {"delaunay", st.delaunay_seconds},
+                  {"recovery", st.recovery_seconds},
+                  {"regions", st.classify_seconds},
+                  {"interior", st.refine_seconds},
+                  {"check", check_s},
+                  {"write", write_s},
+                  {"total", total.seconds()}};
+  if (!o.json_path.empty()) write_json(j, o.json_path);
+  if (!o.quiet) {
+    fmt::print("model: {}  hmin {:.4g}  hmax {:.4g}  curvature {}\n", o.model, sf.hmin, sf.hmax,
+               describe(so.curvature));
+    fmt::print("mesh: {} vertices, {} tets, {} boundary triangles; {} interior points ({} refused)\n",
+               m.num_verts(), nt, m.tris.size(), st.interior_points, st.refused_points);
+    fmt::print("recovery: {} missing edges, {} missing triangles; {} Steiner points ({} on model edges, {} on model "
+               "faces) in {} rounds\n",
+               st.recovery.missing_edges_initial, st.recovery.missing_triangles_initial, steiner,
+               st.recovery.steiner_on_edges, st.recovery.steiner_on_faces, st.recovery.rounds);
+    fmt::print("quality: mean ratio min {:.3f} mean {:.3f}; min dihedral {:.2f} deg\n", qs.min, qs.mean, ds.min);
+    fmt::print("volume: mesh {:.6g}, model {:.6g} (relative difference {:.2e})\n", vol_mesh, vol_model,
+               vol_model > 0 ? (vol_mesh - vol_model) / vol_model : 0.0);
+    fmt::print("check: {}", ok ? "valid" : "INVALID");
+    if (!ok)
+      fmt::print(" ({} validity issues, {} vertices off their entity, {} folded boundary triangles)",
+                 valid.num_issues, rep.vertices_off_entity, rep.folded_triangles);
+    fmt::print("\n");
+    for (std::size_t i = 0; i < std::min<std::size_t>(valid.issues.size(), 5); ++i)
+      fmt::print("  {}\n", valid.issues[i].message);
+    fmt::print("time: load {:.2f} s, size field {:.2f} s, boundary {:.2f} s, delaunay {:.2f} s, recovery {:.2f} s, "
+               "regions {:.2f} s, interior {:.2f} s, check {:.2f} s, write {:.2f} s, total {:.2f} s\n",
+               load_s, size_s, st.boundary_seconds, st.delaunay_seconds, st.recovery_seconds, st.classify_seconds,
+               st.refine_seconds, check_s, write_s, total.seconds());
+    if (!o.output.empty()) fmt::print("wrote {}\n", o.output);
+  }
+  return ok ? kExitOk : kExitInvalidMesh;
+}
+
 }  // namespace
 
 void add_mesh_command(CLI::App& app, Runner& runner) {
   auto o = std::make_shared<MeshCliOptions>();
-  CLI::App* cmd = app.add_subcommand("mesh", "Mesh a model: the classified surface mesh (--dim 2)");
+  CLI::App* cmd = app.add_subcommand("mesh", "Mesh a model: the classified tetrahedral mesh (or --dim 2: its surface)");
   cmd->add_option("model", o->model, "STEP/IGES/BREP file or builtin:NAME[:key=value,...]")->required();
   cmd->add_option("-o,--output", o->output, "Output mesh (.msh, .mesh/.meshb, .vtu)");
-  cmd->add_option("--dim", o->dim, "Dimension of the mesh: 2 = boundary (surface) mesh")
-      ->required()
-      ->check(CLI::IsMember({2}));
+  cmd->add_option("--dim", o->dim, "3 = volume mesh (default), 2 = boundary (surface) mesh only")
+      ->check(CLI::IsMember({2, 3}));
   cmd->add_option("--json", o->json_path, "Write the summary as JSON");
   add_size_flags(cmd, o->size);
   add_model_flags(cmd, o->model_flags);
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
   cmd->footer(
-      "Exit code 0 when the surface mesh passes its checks against the model (vertices on their\n"
-      "entities, no folded triangle, every region closed), 1 when it does not, 2 on bad input.\n"
-      "\nExamples:\n  curvemesh mesh part.step --dim 2 -o part_surface.msh\n"
+      "Exit code 0 when the mesh passes its checks (volume: every tet positive, conforming,\n"
+      "classification consistent, boundary vertices on their model entities; surface: vertices on\n"
+      "their entities, no folded triangle, every region closed), 1 when it does not, 2 on bad input,\n"
+      "3 on an internal error.\n"
+      "\nExamples:\n  curvemesh mesh part.step -o part.msh\n  curvemesh mesh part.step --dim 2 -o part_surface.msh\n"
       "  curvemesh mesh builtin:torus --dim 2 --curv-eps 0.01 -o torus.vtu");
   cmd->callback([&runner, o] { runner = [o] { return run_mesh(*o); }; });
 }

@@ -34,6 +34,7 @@ BoundaryReport check_boundary(const geom::Model& model, const mesh::TetMesh& m, 
   std::vector<double> rel(m.num_verts(), 0);
   tbb::parallel_for(std::size_t{0}, m.num_verts(), [&](std::size_t v) {
     const mesh::ModelRef c = m.vert_class[v];
+    if (c.dim == 3) return;  // interior vertices of a volume mesh are on their region by construction
     Vec3 on;
     if (c.dim == 0) on = model.vertex_point(c.tag);
     else if (c.dim == 1) on = model.edge_point(c.tag, m.vert_param[v].u);

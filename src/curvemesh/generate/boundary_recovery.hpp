@@ -1,0 +1,46 @@
+#pragma once
+// Boundary recovery of the assurance algorithm (seed paper 1, §2): make every
+// edge and triangle of the classified surface mesh an edge and a face of the
+// Delaunay tetrahedralization of its points.
+//
+// Method: conforming recovery by Steiner points on the model. A missing mesh
+// edge is split at the point of its model entity closest to its midpoint — on
+// the model edge (parameter kept) when it is a model-edge segment, else on the
+// model face ((u, v) kept) — the triangles around it are split too, and the
+// point is inserted in the Delaunay mesh. A missing triangle whose edges are
+// all present has its longest edge split. Splits shrink the local spacing
+// until every surface simplex is Delaunay; since points are only added on the
+// model, geometric similarity holds throughout. The loop is bounded: if it has
+// not converged after max_rounds or max_steiner points it throws
+// cm::GeometryError naming the model face where recovery failed.
+#include <cstddef>
+
+#include "curvemesh/generate/delaunay3d.hpp"
+#include "curvemesh/geom/model.hpp"
+
+namespace cm::generate {
+
+struct RecoveryOptions {
+  int max_rounds = 200;
+  /// Steiner points allowed, as a multiple of the initial surface vertices.
+  double max_steiner_factor = 4.0;
+};
+
+struct RecoveryStats {
+  std::size_t missing_edges_initial = 0, missing_triangles_initial = 0;
+  std::size_t steiner_on_edges = 0, steiner_on_faces = 0;
+  int rounds = 0;
+};
+
+/// `dt` triangulates (among others) every vertex of its mesh's `tris` and
+/// `edges`. On return every tri is a face of the tetrahedralization and every
+/// classified edge an edge of it; tris, edges, coords, vert_class and
+/// vert_param include the Steiner points.
+RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const RecoveryOptions& options = {});
+
+/// True if (a, b) is an edge of the tetrahedralization (walks a's ball).
+bool has_edge(const mesh::TetMesh& m, VertId a, VertId b, std::vector<TetId>& scratch);
+/// True if (a, b, c) is a face of the tetrahedralization.
+bool has_face(const mesh::TetMesh& m, VertId a, VertId b, VertId c, std::vector<TetId>& scratch);
+
+}  // namespace cm::generate

@@ -1,0 +1,87 @@
+#pragma once
+// Incremental 3D Delaunay tetrahedralization (Bowyer–Watson) built on the
+// cavity kernel of modify/.
+//
+// - Starts from one enclosing tetrahedron whose four "far" vertices are
+//   appended to the mesh; every later point must lie strictly inside it.
+// - Point location: visibility walk with exact orient3d from a hint (the last
+//   created tet by default), the face order varied so the walk cannot cycle.
+// - Cavity: the tets whose circumsphere strictly contains the point, grown
+//   face by face from the located tet. Cospherical ties are broken by a
+//   symbolic perturbation of the lifting (each point lifted by ε^(rank), rank
+//   = vertex id), so the triangulation is the unique Delaunay triangulation of
+//   the perturbed points: no flat tets, every cavity star-shaped, whatever the
+//   degeneracy (grids, cospherical or coplanar sets).
+// - Constrained insertion: faces registered with protect() are never crossed
+//   by a cavity (interior points never cut a recovered boundary face); such a
+//   cavity may not be star-shaped, and the point is then refused.
+// - Duplicate points are refused and reported with the vertex they repeat.
+#include <array>
+#include <span>
+#include <unordered_set>
+#include <vector>
+
+#include "curvemesh/mesh/tet_mesh.hpp"
+#include "curvemesh/modify/cavity.hpp"
+#include "curvemesh/modify/mesh_editor.hpp"
+
+namespace cm::generate {
+
+/// insphere with the symbolic perturbation described above: never 0 for a
+/// positive tet `t` and a point e that is not one of its vertices.
+int insphere_perturbed(const mesh::TetMesh& m, const std::array<VertId, 4>& t, VertId e);
+
+class Delaunay3d {
+ public:
+  /// `m` holds the points to insert later (any vertices; may have no tets).
+  /// Appends the 4 far vertices around the box [lo, hi] and the enclosing tet.
+  Delaunay3d(mesh::TetMesh& m, const Vec3& lo, const Vec3& hi);
+
+  modify::MeshEditor& editor() { return editor_; }
+  mesh::TetMesh& mesh() { return editor_.mesh(); }
+  const std::array<VertId, 4>& far_vertices() const { return far_; }
+  bool is_far(VertId v) const { return v >= far_[0] && v <= far_[3]; }
+
+  /// The live tet containing x (closed), walking from `hint` (or the last
+  /// created tet). Throws std::domain_error if x is outside the enclosing tet.
+  TetId locate(const Vec3& x, TetId hint = kNone);
+
+  struct Result {
+    modify::Refusal refusal = modify::Refusal::kNone;
+    VertId duplicate_of = kNone;  ///< for kDuplicatePoint
+    std::size_t cavity_size = 0;
+  };
+  /// Inserts vertex v (already in the mesh's coords, in no tet).
+  Result insert(VertId v, TetId hint = kNone);
+  /// Inserts many vertices in BRIO + Hilbert order; returns, per input
+  /// position, the vertex it duplicates or kNone.
+  std::vector<VertId> insert_all(std::span<const VertId> verts);
+
+  /// Faces (vertex triples, any order) that cavities must not cross.
+  void protect(const std::array<VertId, 3>& face);
+  bool is_protected(const std::array<VertId, 3>& face) const;
+  std::size_t protected_faces() const { return protected_.size(); }
+
+  /// Tet created by the last successful insertion (a good walk start).
+  TetId last_tet() const { return last_; }
+  std::size_t exact_walk_steps() const { return walk_steps_; }
+
+ private:
+  struct TripleHash {
+    std::size_t operator()(const std::array<VertId, 3>& k) const {
+      return (std::size_t{k[0]} * 0x9E3779B97F4A7C15ull) ^ (std::size_t{k[1]} * 0xC2B2AE3D27D4EB4Full) ^
+             (std::size_t{k[2]} * 0x165667B19E3779F9ull);
+    }
+  };
+
+  modify::MeshEditor editor_;
+  modify::Cavity cavity_;
+  std::array<VertId, 4> far_{};
+  TetId last_ = 0;
+  std::uint64_t rng_ = 0x9E3779B97F4A7C15ull;
+  std::size_t walk_steps_ = 0;
+  std::unordered_set<std::array<VertId, 3>, TripleHash> protected_;
+  std::vector<TetId> stack_;
+};
+
+}  // namespace cm::generate

@@ -1,0 +1,284 @@
+#include "curvemesh/generate/volume_mesh.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "curvemesh/core/error.hpp"
+#include "curvemesh/core/predicates.hpp"
+#include "curvemesh/core/timer.hpp"
+#include "curvemesh/generate/delaunay3d.hpp"
+#include "curvemesh/mesh/adjacency.hpp"
+#include "curvemesh/mesh/topology.hpp"
+
+namespace cm::generate {
+
+namespace {
+
+// Which region lies behind (against the normal) and in front of each model
+// face, from the regions' shells; 0 = no region (outside the model).
+struct FaceSides {
+  std::vector<std::int32_t> behind, front;
+};
+
+FaceSides face_sides(const geom::Model& model) {
+  FaceSides s;
+  const int nf = model.count(2);
+  s.behind.assign(static_cast<std::size_t>(nf) + 1, 0);
+  s.front.assign(static_cast<std::size_t>(nf) + 1, 0);
+  for (int r = 1; r <= model.count(3); ++r)
+    for (const auto& use : model.region_faces(r)) (use.forward ? s.behind : s.front)[use.tag] = r;
+  return s;
+}
+
+bool same_cycle(const std::array<VertId, 3>& a, const std::array<VertId, 3>& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a[0] == b[k] && a[1] == b[(k + 1) % 3] && a[2] == b[(k + 2) % 3]) return true;
+  return false;
+}
+
+std::array<VertId, 3> sorted3(std::array<VertId, 3> k) {
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+// Region classification by inheritance: tets connected without crossing a
+// boundary triangle form a component; each boundary triangle tells, by its
+// orientation, which region lies on each of its sides; a component takes the
+// region its triangles vote for. Components touching the enclosing tet are
+// outside. Returns the number of triangles whose vote disagreed.
+std::size_t classify_regions(const geom::Model& model, Delaunay3d& dt) {
+  auto& m = dt.mesh();
+  auto& ed = dt.editor();
+  const FaceSides sides = face_sides(model);
+  std::map<std::array<VertId, 3>, std::uint32_t> tri_of;
+  for (std::uint32_t i = 0; i < m.tris.size(); ++i) tri_of[sorted3(m.tris[i].verts)] = i;
+
+  const std::size_t nt = m.tet2verts.size();
+  std::vector<std::int32_t> comp(nt, -1);
+  std::vector<TetId> stack;
+  std::size_t conflicts = 0;
+  int ncomp = 0;
+  for (TetId seed = 0; seed < nt; ++seed) {
+    if (ed.is_dead(seed) || comp[seed] >= 0) continue;
+    std::map<std::int32_t, std::size_t> votes;
+    bool far = false;
+    std::vector<TetId> members;
+    comp[seed] = ncomp;
+    stack.assign(1, seed);
+    while (!stack.empty()) {
+      const TetId t = stack.back();
+      stack.pop_back();
+      members.push_back(t);
+      const auto& tv = m.tet2verts[t];
+      for (VertId v : tv) far |= dt.is_far(v);
+      for (int f = 0; f < 4; ++f) {
+        const auto& fv = mesh::kFaceVerts[f];
+        const std::array<VertId, 3> face{tv[fv[0]], tv[fv[1]], tv[fv[2]]};
+        if (auto it = tri_of.find(sorted3(face)); it != tri_of.end()) {
+          const auto& tri = m.tris[it->second];
+          // t's face is oriented out of t: same orientation as the triangle
+          // (which follows the face normal) means t is behind the face.
+          const bool behind = same_cycle(face, tri.verts);
+          ++votes[behind ? sides.behind[tri.face_tag] : sides.front[tri.face_tag]];
+          continue;
+        }
+        const Index a = m.tet2adj[4 * t + f];
+        if (a == kNone) continue;
+        const TetId n = mesh::face_tet(a);
+        if (comp[n] < 0) {
+          comp[n] = ncomp;
+          stack.push_back(n);
+        }
+      }
+    }
+    std::int32_t region = 0;
+    if (!far) {
+      std::size_t best = 0;
+      for (const auto& [r, c] : votes)
+        if (c > best) {
+          best = c;
+          region = r;
+        }
+    }
+    for (const auto& [r, c] : votes)
+      if (r != region) conflicts += c;
+    for (TetId t : members) m.tet_region[t] = region;
+    ++ncomp;
+  }
+  return conflicts;
+}
+
+// Deletes the tets of region 0 (hull faces left kNone).
+std::size_t remove_outside(Delaunay3d& dt) {
+  auto& m = dt.mesh();
+  auto& ed = dt.editor();
+  std::size_t removed = 0;
+  for (TetId t = 0; t < m.tet2verts.size(); ++t) {
+    if (ed.is_dead(t) || m.tet_region[t] != 0) continue;
+    for (int f = 0; f < 4; ++f) {
+      const Index a = m.tet2adj[4 * t + f];
+      if (a != kNone && m.tet_region[mesh::face_tet(a)] != 0) m.tet2adj[a] = kNone;
+    }
+    ed.release(t);
+    ++removed;
+  }
+  for (VertId v = 0; v < m.vert2tet.size(); ++v)
+    if (m.vert2tet[v] != kNone && ed.is_dead(m.vert2tet[v])) m.vert2tet[v] = kNone;
+  // Survivors re-seed their vertices.
+  for (TetId t = 0; t < m.tet2verts.size(); ++t)
+    if (!ed.is_dead(t))
+      for (VertId v : m.tet2verts[t]) m.vert2tet[v] = t;
+  return removed;
+}
+
+Vec3 circumcentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const Vec3 u = b - a, v = c - a, w = d - a;
+  const double det = 2.0 * u.dot(v.cross(w));
+  return a + (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u) + w.squaredNorm() * u.cross(v)) / det;
+}
+
+// Delaunay refinement to the size field: circumcentres of tets too large for
+// the size are inserted (never across a boundary face), largest first.
+void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMeshOptions& o, VolumeMeshStats& st) {
+  auto& m = dt.mesh();
+  auto& ed = dt.editor();
+  for (const auto& t : m.tris) dt.protect(t.verts);
+  std::vector<TetId> queue;
+  for (TetId t = 0; t < m.tet2verts.size(); ++t)
+    if (!ed.is_dead(t)) queue.push_back(t);
+  ed.set_hook([&queue](const mesh::TetMesh&, std::span<const TetId> created) {
+    queue.insert(queue.end(), created.begin(), created.end());
+  });
+  std::vector<TetId> next;
+  while (!queue.empty()) {
+    // One sweep over the current queue; new tets go to the next sweep.
+    std::swap(queue, next);
+    queue.clear();
+    for (TetId t : next) {
+      if (ed.is_dead(t)) continue;
+      const auto tv = m.tet2verts[t];
+      const Vec3 cc = circumcentre(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
+      if (!cc.allFinite()) continue;
+      const double r = (cc - m.coords[tv[0]]).norm();
+      const double h = size.size(cc);
+      if (!(r > o.radius_factor * h)) continue;
+      TetId home;
+      try {
+        home = dt.locate(cc, t);
+      } catch (const std::domain_error&) {
+        continue;
+      }
+      if (m.tet_region[home] != m.tet_region[t] || m.tet_region[home] == 0) continue;
+      // Too close to the boundary: the new tets against it would be flat.
+      bool close = false;
+      for (int f = 0; f < 4 && !close; ++f) {
+        const auto& hv = m.tet2verts[home];
+        const auto& fv = mesh::kFaceVerts[f];
+        const std::array<VertId, 3> face{hv[fv[0]], hv[fv[1]], hv[fv[2]]};
+        if (!dt.is_protected(face)) continue;
+        const Vec3 n = (m.coords[face[1]] - m.coords[face[0]]).cross(m.coords[face[2]] - m.coords[face[0]]);
+        close = std::abs(n.normalized().dot(cc - m.coords[face[0]])) < o.boundary_clearance * h;
+      }
+      if (close) {
+        ++st.refused_points;
+        continue;
+      }
+      const VertId p = m.add_vert(cc);
+      m.resize_vertex_arrays();
+      m.vert_class[p] = {3, m.tet_region[home]};
+      const auto res = dt.insert(p, home);
+      if (res.refusal != modify::Refusal::kNone) {
+        m.coords.pop_back();
+        m.resize_vertex_arrays();
+        m.vert2tet.resize(m.coords.size());
+        ++st.refused_points;
+        continue;
+      }
+      ++st.interior_points;
+    }
+  }
+  ed.set_hook({});
+}
+
+// Drops far and unused vertices and renumbers everything.
+void compact_vertices(mesh::TetMesh& m) {
+  std::vector<VertId> remap(m.coords.size(), kNone);
+  VertId next = 0;
+  std::vector<char> used(m.coords.size(), 0);
+  for (const auto& t : m.tet2verts)
+    for (VertId v : t) used[v] = 1;
+  for (VertId v = 0; v < m.coords.size(); ++v)
+    if (used[v]) {
+      remap[v] = next;
+      m.coords[next] = m.coords[v];
+      m.vert_class[next] = m.vert_class[v];
+      m.vert_param[next] = m.vert_param[v];
+      ++next;
+    }
+  m.coords.resize(next);
+  m.vert_class.resize(next);
+  m.vert_param.resize(next);
+  for (auto& t : m.tet2verts)
+    for (VertId& v : t) v = remap[v];
+  for (auto& t : m.tris)
+    for (VertId& v : t.verts) v = remap[v];
+  for (auto& e : m.edges)
+    for (VertId& v : e.verts) v = remap[v];
+  m.vert2tet.assign(next, kNone);
+  for (TetId t = 0; t < m.tet2verts.size(); ++t)
+    for (VertId v : m.tet2verts[t]) m.vert2tet[v] = t;
+}
+
+}  // namespace
+
+mesh::TetMesh mesh_volume_from_boundary(const geom::Model& model, const size::SizeField& size, mesh::TetMesh m,
+                                        const VolumeMeshOptions& o, VolumeMeshStats* stats) {
+  VolumeMeshStats local;
+  VolumeMeshStats& st = stats ? *stats : local;
+  st.boundary_vertices = m.num_verts();
+  st.boundary_triangles = m.tris.size();
+  if (m.tris.empty()) throw GeometryError("the model has no boundary faces to mesh");
+  Timer step;
+  m.tet2verts.clear();
+  m.tet_region.clear();
+  m.tet2adj.clear();
+  m.vert2tet.assign(m.coords.size(), kNone);
+  geom::BoundingBox box;
+  for (const Vec3& x : m.coords) box.add(x);
+  std::vector<VertId> ids(m.coords.size());
+  for (VertId v = 0; v < ids.size(); ++v) ids[v] = v;
+  Delaunay3d dt(m, box.min, box.max);
+  const auto dup = dt.insert_all(ids);
+  for (std::size_t i = 0; i < dup.size(); ++i)
+    if (dup[i] != kNone)
+      throw GeometryError(fmt::format("boundary vertices {} and {} coincide (at {:.6g} {:.6g} {:.6g})", i, dup[i],
+                                      m.coords[i].x(), m.coords[i].y(), m.coords[i].z()));
+  st.delaunay_seconds = step.seconds();
+  step.reset();
+  st.recovery = recover_boundary(model, dt, o.recovery);
+  st.recovery_seconds = step.seconds();
+  step.reset();
+  st.region_conflicts = classify_regions(model, dt);
+  st.outside_tets = remove_outside(dt);
+  st.classify_seconds = step.seconds();
+  step.reset();
+  if (o.refine) refine_interior(size, dt, o, st);
+  st.refine_seconds = step.seconds();
+  dt.editor().compact();
+  compact_vertices(m);
+  return m;
+}
+
+mesh::TetMesh mesh_volume(const geom::Model& model, const size::SizeField& size, const VolumeMeshOptions& o,
+                          VolumeMeshStats* stats) {
+  VolumeMeshStats local;
+  VolumeMeshStats& st = stats ? *stats : local;
+  Timer step;
+  mesh::TetMesh surface = mesh_boundary(model, size, o.boundary, &st.boundary);
+  st.boundary_seconds = step.seconds();
+  return mesh_volume_from_boundary(model, size, std::move(surface), o, &st);
+}
+
+}  // namespace cm::generate

@@ -1,0 +1,78 @@
+#include "curvemesh/modify/mesh_editor.hpp"
+
+#include <algorithm>
+
+namespace cm::modify {
+
+MeshEditor::MeshEditor(mesh::TetMesh& m) : m_(&m) {
+  if (m.tet2adj.size() != 4 * m.tet2verts.size()) m.tet2adj.assign(4 * m.tet2verts.size(), kNone);
+  if (m.tet_region.size() != m.tet2verts.size()) m.tet_region.resize(m.tet2verts.size(), 0);
+  if (m.vert2tet.size() != m.coords.size()) m.vert2tet.resize(m.coords.size(), kNone);
+  for (TetId t = 0; t < m.tet2verts.size(); ++t)
+    if (m.tet2verts[t][0] == kNone) free_.push_back(t);
+  // Reuse low slots first so compact() moves little.
+  std::sort(free_.rbegin(), free_.rend());
+}
+
+TetId MeshEditor::allocate(const std::array<VertId, 4>& v, std::int32_t region) {
+  TetId t;
+  if (!free_.empty()) {
+    t = free_.back();
+    free_.pop_back();
+    m_->tet2verts[t] = v;
+    m_->tet_region[t] = region;
+    for (int f = 0; f < 4; ++f) m_->tet2adj[4 * t + f] = kNone;
+  } else {
+    t = static_cast<TetId>(m_->tet2verts.size());
+    m_->tet2verts.push_back(v);
+    m_->tet_region.push_back(region);
+    m_->tet2adj.insert(m_->tet2adj.end(), 4, kNone);
+  }
+  if (m_->vert2tet.size() < m_->coords.size()) m_->vert2tet.resize(m_->coords.size(), kNone);
+  for (VertId x : v) m_->vert2tet[x] = t;
+  return t;
+}
+
+void MeshEditor::release(TetId t) {
+  m_->tet2verts[t][0] = kNone;
+  free_.push_back(t);
+}
+
+std::uint32_t MeshEditor::next_epoch() {
+  if (++epoch_ == 0) {  // wrapped: old stamps could alias the new epoch
+    std::fill(stamps_.begin(), stamps_.end(), 0);
+    epoch_ = 1;
+  }
+  return epoch_;
+}
+
+std::vector<TetId> MeshEditor::compact() {
+  auto& m = *m_;
+  const std::size_t n = m.tet2verts.size();
+  std::vector<TetId> remap(n, kNone);
+  TetId next = 0;
+  for (TetId t = 0; t < n; ++t)
+    if (m.tet2verts[t][0] != kNone) remap[t] = next++;
+  for (TetId t = 0; t < n; ++t) {
+    const TetId nt = remap[t];
+    if (nt == kNone) continue;
+    m.tet2verts[nt] = m.tet2verts[t];
+    m.tet_region[nt] = m.tet_region[t];
+    for (int f = 0; f < 4; ++f) {
+      const Index a = m.tet2adj[4 * t + f];
+      m.tet2adj[4 * nt + f] = a == kNone ? kNone : mesh::pack_face(remap[mesh::face_tet(a)], mesh::face_index(a));
+    }
+  }
+  m.tet2verts.resize(next);
+  m.tet_region.resize(next);
+  m.tet2adj.resize(4 * static_cast<std::size_t>(next));
+  m.vert2tet.assign(m.coords.size(), kNone);
+  for (TetId t = 0; t < next; ++t)
+    for (VertId v : m.tet2verts[t]) m.vert2tet[v] = t;
+  free_.clear();
+  stamps_.assign(stamps_.size(), 0);
+  epoch_ = 1;
+  return remap;
+}
+
+}  // namespace cm::modify

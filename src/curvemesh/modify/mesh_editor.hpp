@@ -1,0 +1,75 @@
+#pragma once
+// Editing a TetMesh in place: the bookkeeping every cavity operation shares.
+//
+// Operators delete a cavity of tets and fill it with new ones many millions of
+// times, so tets are never erased from the arrays: a deleted tet becomes a
+// "dead" slot (its first vertex is kNone) that the next allocation reuses, and
+// compact() squeezes the arrays once at the end. Per-tet stamps let operators
+// mark cavity membership in O(1) without clearing a set per call.
+//
+// Contract:
+// - The mesh must have valid adjacency (build_adjacency) when the editor is
+//   made; the editor keeps tet2adj and vert2tet valid for live tets through
+//   every rebuild (vert2tet[v] always names a live tet containing v, or kNone
+//   when v has no tet).
+// - While an editor exists, code that walks tet2verts must skip dead tets
+//   (is_dead) — validate.hpp and the writers expect compact() first.
+// - Not thread-safe: one editor, one thread.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "curvemesh/mesh/tet_mesh.hpp"
+
+namespace cm::modify {
+
+/// Called after every cavity rebuild with the tets it created (already linked
+/// into adjacency). This is where curving places high-order nodes on new
+/// entities and where drivers queue new tets for inspection.
+using RebuildHook = std::function<void(const mesh::TetMesh&, std::span<const TetId> created)>;
+
+class MeshEditor {
+ public:
+  explicit MeshEditor(mesh::TetMesh& m);
+
+  mesh::TetMesh& mesh() { return *m_; }
+  const mesh::TetMesh& mesh() const { return *m_; }
+
+  bool is_dead(TetId t) const { return m_->tet2verts[t][0] == kNone; }
+  std::size_t live_tets() const { return m_->tet2verts.size() - free_.size(); }
+
+  /// A slot for a new tet (reusing a dead one when possible). Adjacency of
+  /// the new tet is all kNone; the caller links it.
+  TetId allocate(const std::array<VertId, 4>& v, std::int32_t region);
+  /// Marks t dead. Its adjacency entries are left for the caller to rewire.
+  void release(TetId t);
+
+  /// Stamps: stamp(t) == epoch() means "marked in the current operation".
+  /// next_epoch() invalidates every mark in O(1).
+  std::uint32_t next_epoch();
+  std::uint32_t epoch() const { return epoch_; }
+  void mark(TetId t) { grow_stamps(); stamps_[t] = epoch_; }
+  bool marked(TetId t) const { return t < stamps_.size() && stamps_[t] == epoch_; }
+
+  void set_hook(RebuildHook hook) { hook_ = std::move(hook); }
+  const RebuildHook& hook() const { return hook_; }
+
+  /// Removes dead tets (renumbering the rest in order), rebuilds vert2tet;
+  /// returns old id -> new id (kNone for dead). Invalidates stamps.
+  std::vector<TetId> compact();
+
+ private:
+  void grow_stamps() {
+    if (stamps_.size() < m_->tet2verts.size()) stamps_.resize(m_->tet2verts.size() + m_->tet2verts.size() / 2 + 16, 0);
+  }
+
+  mesh::TetMesh* m_;
+  std::vector<TetId> free_;
+  std::vector<std::uint32_t> stamps_;
+  std::uint32_t epoch_ = 1;
+  RebuildHook hook_;
+};
+
+}  // namespace cm::modify
