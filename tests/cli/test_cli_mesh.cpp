@@ -1,5 +1,5 @@
-// `curvemesh mesh --dim 2` as a user runs it: classified surface mesh out,
-// summary and exit codes.
+// `curvemesh mesh` as a user runs it: classified volume mesh (default) or
+// surface mesh (--dim 2) out, summary and exit codes.
 #include <gtest/gtest.h>
 
 #include <set>
@@ -9,6 +9,8 @@
 #include "cli_runner.hpp"
 #include "curvemesh/io/atomic_file.hpp"
 #include "curvemesh/io/formats.hpp"
+#include "curvemesh/io/mesh_io.hpp"
+#include "curvemesh/mesh/validate.hpp"
 
 using cm::test::run_cli;
 
@@ -35,8 +37,26 @@ TEST(CliMesh, SurfaceMeshOfABuiltinIsWrittenClassifiedAndChecked) {
   EXPECT_EQ(run_cli("mesh builtin:cylinder --dim 2 -q -o " + dir + "/cyl.vtu").exit_code, 0);
 }
 
+TEST(CliMesh, VolumeMeshIsTheDefaultAndReadsBackValid) {
+  const std::string dir = cm::test::make_temp_dir("mesh3");
+  const auto r = run_cli("mesh builtin:box -o " + dir + "/box.msh --json " + dir + "/box.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("check: valid"), std::string::npos) << r.output;
+  const auto j = nlohmann::json::parse(cm::test::read_text(dir + "/box.json"));
+  EXPECT_EQ(j["dim"].get<int>(), 3);
+  const cm::mesh::TetMesh m = cm::io::read_mesh(dir + "/box.msh");
+  EXPECT_EQ(m.num_tets(), j["counts"]["tets"].get<std::size_t>());
+  EXPECT_TRUE(cm::mesh::validate(m, cm::mesh::Level::kFull).valid());
+  double vol = 0;
+  for (cm::TetId t = 0; t < m.num_tets(); ++t) vol += cm::mesh::tet_volume(m, t);
+  EXPECT_NEAR(vol, 1.0, 1e-9);  // the unit box: planar faces, no chord error
+  // The file passes `check` too.
+  EXPECT_EQ(run_cli("check " + dir + "/box.msh -q").exit_code, 0);
+  EXPECT_EQ(run_cli("mesh builtin:sphere -q --dim 3 -o " + dir + "/sphere.vtu").exit_code, 0);
+}
+
 TEST(CliMesh, BadUseExitsTwo) {
-  EXPECT_EQ(run_cli("mesh builtin:box").exit_code, 2);           // --dim is required
-  EXPECT_EQ(run_cli("mesh builtin:box --dim 3").exit_code, 2);   // only the boundary mesh so far
+  EXPECT_EQ(run_cli("mesh builtin:box --dim 4").exit_code, 2);
+  EXPECT_EQ(run_cli("mesh builtin:nosuch").exit_code, 2);
   EXPECT_EQ(run_cli("mesh builtin:nosuch --dim 2").exit_code, 2);
 }

@@ -147,7 +147,8 @@ TEST(Delaunay3d, ProtectedFacesAreNeverCrossed) {
   Delaunay3d dt(m, Vec3(-1, -1, -1), Vec3(1, 1, 1));
   for (VertId v = 0; v < 5; ++v) ASSERT_EQ(dt.insert(v).refusal, modify::Refusal::kNone);
   // Triangle (0,1,2) is present (it separates 3 from 4 at these positions).
-  dt.protect({0, 1, 2});
+  ASSERT_TRUE(dt.protect({0, 1, 2}));
+  EXPECT_FALSE(dt.protect({0, 3, 4}));  // not a face: 3 and 4 are on opposite sides
   EXPECT_TRUE(dt.is_protected({2, 0, 1}));
   const VertId p = m.add_vert(Vec3(0.25, 0.25, 0.01));
   m.resize_vertex_arrays();
@@ -162,6 +163,7 @@ TEST(Delaunay3d, ProtectedFacesAreNeverCrossed) {
       found |= c == 3;
     }
     EXPECT_TRUE(found);
+    EXPECT_TRUE(dt.is_protected({0, 1, 2}));  // the mark followed the face
   } else {
     EXPECT_EQ(r.refusal, modify::Refusal::kNotStarShaped);
   }

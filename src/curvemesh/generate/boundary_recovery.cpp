@@ -1,7 +1,9 @@
 #include "curvemesh/generate/boundary_recovery.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <fmt/format.h>
 
@@ -12,6 +14,18 @@ namespace cm::generate {
 
 namespace {
 
+using Triple = std::array<VertId, 3>;
+struct TripleHash {
+  std::size_t operator()(const Triple& k) const {
+    return (std::size_t{k[0]} * 0x9E3779B97F4A7C15ull) ^ (std::size_t{k[1]} * 0xC2B2AE3D27D4EB4Full) ^
+           (std::size_t{k[2]} * 0x165667B19E3779F9ull);
+  }
+};
+Triple sorted3(Triple k) {
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
 std::uint64_t edge_key(VertId a, VertId b) {
   if (a > b) std::swap(a, b);
   return (std::uint64_t{a} << 32) | b;
@@ -21,7 +35,7 @@ std::uint64_t edge_key(VertId a, VertId b) {
 // edge -> model-edge segment.
 class Surface {
  public:
-  Surface(const geom::Model& model, mesh::TetMesh& m) : model_(model), m_(m) {
+  Surface(const geom::Model& model, mesh::TetMesh& m) : model_(model), m_(m), first_steiner_(m.coords.size()) {
     for (std::uint32_t t = 0; t < m.tris.size(); ++t)
       for (const auto& e : mesh::kTriEdges) tris_of_[edge_key(m.tris[t].verts[e[0]], m.tris[t].verts[e[1]])].push_back(t);
     for (std::uint32_t s = 0; s < m.edges.size(); ++s) segment_of_[edge_key(m.edges[s].verts[0], m.edges[s].verts[1])] = s;
@@ -34,14 +48,38 @@ class Surface {
   /// Splits surface edge (a, b) on its model entity; returns the new vertex.
   VertId split(VertId a, VertId b, RecoveryStats& st) {
     const std::uint64_t key = edge_key(a, b);
-    const Vec3 mid = 0.5 * (m_.coords[a] + m_.coords[b]);
+    // Where to split: the midpoint, except on an edge from an original
+    // vertex to a Steiner point, which is split at a power-of-two distance
+    // from the original vertex (Ruppert's concentric shells). Splits around
+    // a vertex with small angles between its surface edges then land on
+    // common spheres and stop encroaching on each other; plain midpoints can
+    // cascade forever there.
+    double w = 0.5;  // fraction of the way from a to b
+    const bool a_orig = a < first_steiner_, b_orig = b < first_steiner_;
+    if (a_orig != b_orig) {
+      const double len = (m_.coords[b] - m_.coords[a]).norm();
+      const double d = std::exp2(std::round(std::log2(0.5 * len)));
+      w = std::clamp(a_orig ? d / len : 1.0 - d / len, 0.25, 0.75);
+    }
+    const Vec3 mid = (1 - w) * m_.coords[a] + w * m_.coords[b];
     VertId p;
     if (auto seg = segment_of_.find(key); seg != segment_of_.end()) {
       const int e = m_.edges[seg->second].edge_tag;
-      std::optional<Vec2> hint;
-      for (VertId v : {a, b})
-        if (m_.vert_class[v] == mesh::ModelRef{1, e}) hint = Vec2(m_.vert_param[v].u, 0);
-      const auto pr = model_.closest_point({1, e}, mid, hint);
+      // Halve the parameter interval when both ends have a parameter on the
+      // edge: progress is guaranteed even where closest-point projection is
+      // ambiguous (tiny or nearly closed edges).
+      const auto ua = param_on_edge(a, e), ub = param_on_edge(b, e, ua);
+      geom::Projection pr;
+      if (ua && ub) {
+        const double u = (1 - w) * *ua + w * *ub;
+        pr.point = model_.edge_point(e, u);
+        pr.param = Vec2(u, 0);
+      } else {
+        std::optional<Vec2> hint;
+        if (ua) hint = Vec2(*ua, 0);
+        if (ub) hint = Vec2(*ub, 0);
+        pr = model_.closest_point({1, e}, mid, hint);
+      }
       p = m_.add_vert(pr.point);
       m_.resize_vertex_arrays();
       m_.vert_class[p] = {1, e};
@@ -91,8 +129,24 @@ class Surface {
   }
 
  private:
+  /// Parameter of vertex v on model edge e: its own u, or the end of e it
+  /// sits at (for a closed edge, the end nearer `near`).
+  std::optional<double> param_on_edge(VertId v, int e, std::optional<double> near = {}) const {
+    const auto c = m_.vert_class[v];
+    if (c == mesh::ModelRef{1, e}) return m_.vert_param[v].u;
+    if (c.dim != 0) return {};
+    const auto ends = model_.edge_vertices(e);
+    const auto r = model_.param_range({1, e});
+    const bool at0 = ends[0] == c.tag, at1 = ends[1] == c.tag;
+    if (at0 && at1) return near && std::abs(*near - r.u1) < std::abs(*near - r.u0) ? r.u1 : r.u0;
+    if (at0) return r.u0;
+    if (at1) return r.u1;
+    return {};
+  }
+
   const geom::Model& model_;
   mesh::TetMesh& m_;
+  std::size_t first_steiner_;  // vertices from here on were added by recovery (or are far vertices)
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> tris_of_;
   std::unordered_map<std::uint64_t, std::uint32_t> segment_of_;
 };
@@ -125,25 +179,68 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   std::vector<TetId> scratch;
   std::vector<std::pair<VertId, VertId>> to_split;
   int last_face = 0;
+  // After the first round only simplices touching a vertex of a new tet can
+  // have changed: every missing one was split, every other one that vanished
+  // lost it to a cavity, whose vertices all lie in the new tets.
+  std::vector<char> dirty(m.coords.size(), 1);
+  auto& ed = dt.editor();
+  ed.set_hook([&dirty](const mesh::TetMesh& mm, std::span<const TetId> created) {
+    if (dirty.size() < mm.coords.size()) dirty.resize(mm.coords.size() + mm.coords.size() / 2, 0);
+    for (TetId t : created)
+      for (VertId v : mm.tet2verts[t]) dirty[v] = 1;
+  });
+  struct HookReset {
+    modify::MeshEditor& ed;
+    ~HookReset() { ed.set_hook({}); }
+  } hook_reset{ed};
   for (st.rounds = 0;; ++st.rounds) {
     to_split.clear();
     std::size_t missing_tris = 0;
+    std::vector<char> checking(dirty.size(), 0);
+    checking.swap(dirty);
+    auto check = [&](VertId v) { return v < checking.size() && checking[v]; };
+    // A full check (the first round) reads every tet once instead of walking
+    // a ball per surface simplex: boundary-only Delaunay balls are large.
+    std::unordered_set<std::uint64_t> all_edges;
+    std::unordered_set<Triple, TripleHash> all_faces;
+    const bool bulk = st.rounds == 0;
+    if (bulk) {
+      all_edges.reserve(8 * m.tet2verts.size());
+      all_faces.reserve(3 * m.tet2verts.size());
+      for (TetId t = 0; t < m.tet2verts.size(); ++t) {
+        if (dt.editor().is_dead(t)) continue;
+        const auto& tv = m.tet2verts[t];
+        for (const auto& e : mesh::kTetEdges) all_edges.insert(edge_key(tv[e[0]], tv[e[1]]));
+        for (const auto& f : mesh::kFaceVerts) all_faces.insert(sorted3({tv[f[0]], tv[f[1]], tv[f[2]]}));
+      }
+    }
+    auto edge_in = [&](VertId a, VertId b) { return bulk ? all_edges.count(edge_key(a, b)) != 0 : has_edge(m, a, b, scratch); };
+    auto face_in = [&](const std::array<VertId, 3>& v) {
+      return bulk ? all_faces.count(sorted3(v)) != 0 : has_face(m, v[0], v[1], v[2], scratch);
+    };
     for (const auto& [key, tris] : surf.edges()) {
       const auto a = static_cast<VertId>(key >> 32), b = static_cast<VertId>(key & 0xFFFFFFFFu);
-      if (!has_edge(m, a, b, scratch)) {
+      if (!check(a) && !check(b)) continue;
+      if (!edge_in(a, b)) {
         to_split.emplace_back(a, b);
         last_face = m.tris[tris.front()].face_tag;
       }
     }
     for (const auto& s : m.edges)
-      if (!surf.edges().count(edge_key(s.verts[0], s.verts[1])) && !has_edge(m, s.verts[0], s.verts[1], scratch))
+      if ((check(s.verts[0]) || check(s.verts[1])) && !surf.edges().count(edge_key(s.verts[0], s.verts[1])) &&
+          !edge_in(s.verts[0], s.verts[1]))
         to_split.emplace_back(s.verts[0], s.verts[1]);
     const std::size_t missing_edges = to_split.size();
-    if (missing_edges == 0) {
+    if (missing_edges != 0) {
+      // Triangles are checked once the edges are in: keep this round's set.
+      if (dirty.size() < checking.size()) dirty.resize(checking.size(), 0);
+      for (std::size_t v = 0; v < checking.size(); ++v) dirty[v] |= checking[v];
+    } else {
       // Edges all present: a missing triangle gets its longest edge split.
       for (const auto& t : m.tris) {
         const auto& v = t.verts;
-        if (has_face(m, v[0], v[1], v[2], scratch)) continue;
+        if (!check(v[0]) && !check(v[1]) && !check(v[2])) continue;
+        if (face_in(v)) continue;
         ++missing_tris;
         last_face = t.face_tag;
         int longest = 0;
@@ -163,11 +260,15 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
       st.missing_triangles_initial = missing_tris;
     }
     if (to_split.empty()) return st;
-    if (st.rounds >= o.max_rounds || st.steiner_on_edges + st.steiner_on_faces > max_steiner)
+    if (st.rounds >= o.max_rounds || st.steiner_on_edges + st.steiner_on_faces > max_steiner) {
+      const auto [a, b] = to_split.front();
+      const Vec3 x = m.coords[a], y = m.coords[b];
       throw GeometryError(fmt::format("face {}: boundary recovery did not converge ({} rounds, {} Steiner points, "
-                                      "{} edges and {} triangles still missing)",
+                                      "{} edges and {} triangles still missing; one is the edge ({:.6g} {:.6g} "
+                                      "{:.6g})-({:.6g} {:.6g} {:.6g}) of length {:.3g})",
                                       last_face, st.rounds, st.steiner_on_edges + st.steiner_on_faces, missing_edges,
-                                      missing_tris));
+                                      missing_tris, x.x(), x.y(), x.z(), y.x(), y.y(), y.z(), (x - y).norm()));
+    }
     std::sort(to_split.begin(), to_split.end());
     for (const auto& [a, b] : to_split) {
       if (!surf.exists(a, b)) continue;  // already split this round

@@ -5,16 +5,10 @@
 
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/generate/spatial_sort.hpp"
+#include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
 
 namespace cm::generate {
-
-namespace {
-std::array<VertId, 3> sorted3(std::array<VertId, 3> k) {
-  std::sort(k.begin(), k.end());
-  return k;
-}
-}  // namespace
 
 int insphere_perturbed(const mesh::TetMesh& m, const std::array<VertId, 4>& t, VertId e) {
   const double* p[5] = {m.coords[t[0]].data(), m.coords[t[1]].data(), m.coords[t[2]].data(),
@@ -91,10 +85,30 @@ TetId Delaunay3d::locate(const Vec3& x, TetId hint) {
   }
 }
 
-void Delaunay3d::protect(const std::array<VertId, 3>& face) { protected_.insert(sorted3(face)); }
+Index Delaunay3d::find_face(const std::array<VertId, 3>& face) const {
+  const auto& m = editor_.mesh();
+  if (face[0] >= m.vert2tet.size() || m.vert2tet[face[0]] == kNone) return kNone;
+  mesh::collect_ball(m, face[0], ball_);
+  for (TetId t : ball_) {
+    const int i1 = mesh::local_index(m, t, face[1]), i2 = mesh::local_index(m, t, face[2]);
+    if (i1 < 0 || i2 < 0) continue;
+    const int i0 = mesh::local_index(m, t, face[0]);
+    return mesh::pack_face(t, 6 - i0 - i1 - i2);  // the local face opposite the fourth vertex
+  }
+  return kNone;
+}
+
+bool Delaunay3d::protect(const std::array<VertId, 3>& face) {
+  const Index f = find_face(face);
+  if (f == kNone) return false;
+  if (!editor_.face_marked(f)) ++protected_count_;
+  editor_.mark_face(f);
+  return true;
+}
 
 bool Delaunay3d::is_protected(const std::array<VertId, 3>& face) const {
-  return !protected_.empty() && protected_.count(sorted3(face)) != 0;
+  const Index f = find_face(face);
+  return f != kNone && editor_.face_marked(f);
 }
 
 Delaunay3d::Result Delaunay3d::insert(VertId v, TetId hint) {
@@ -112,7 +126,7 @@ Delaunay3d::Result Delaunay3d::insert(VertId v, TetId hint) {
   cavity_.reset(editor_);
   cavity_.add(editor_, t0);
   stack_.assign(1, t0);
-  const bool constrained = !protected_.empty();
+  const bool constrained = protected_count_ != 0;
   while (!stack_.empty()) {
     const TetId t = stack_.back();
     stack_.pop_back();
@@ -121,11 +135,7 @@ Delaunay3d::Result Delaunay3d::insert(VertId v, TetId hint) {
       if (across == kNone) continue;
       const TetId n = mesh::face_tet(across);
       if (cavity_.contains(editor_, n)) continue;
-      if (constrained) {
-        const auto& tv = m.tet2verts[t];
-        const auto& fv = mesh::kFaceVerts[f];
-        if (is_protected({tv[fv[0]], tv[fv[1]], tv[fv[2]]})) continue;
-      }
+      if (constrained && editor_.face_marked(mesh::pack_face(t, f))) continue;
       if (insphere_perturbed(m, m.tet2verts[n], v) > 0) {
         cavity_.add(editor_, n);
         stack_.push_back(n);

@@ -18,7 +18,6 @@
 // - Duplicate points are refused and reported with the vertex they repeat.
 #include <array>
 #include <span>
-#include <unordered_set>
 #include <vector>
 
 #include "curvemesh/mesh/tet_mesh.hpp"
@@ -57,22 +56,20 @@ class Delaunay3d {
   /// position, the vertex it duplicates or kNone.
   std::vector<VertId> insert_all(std::span<const VertId> verts);
 
-  /// Faces (vertex triples, any order) that cavities must not cross.
-  void protect(const std::array<VertId, 3>& face);
+  /// Marks a face of the mesh (vertex triple, any order) that cavities must
+  /// not cross; the mark follows the face through later insertions. Returns
+  /// false if the triple is not a face of the mesh.
+  bool protect(const std::array<VertId, 3>& face);
   bool is_protected(const std::array<VertId, 3>& face) const;
-  std::size_t protected_faces() const { return protected_.size(); }
+  std::size_t protected_faces() const { return protected_count_; }
 
   /// Tet created by the last successful insertion (a good walk start).
   TetId last_tet() const { return last_; }
   std::size_t exact_walk_steps() const { return walk_steps_; }
 
  private:
-  struct TripleHash {
-    std::size_t operator()(const std::array<VertId, 3>& k) const {
-      return (std::size_t{k[0]} * 0x9E3779B97F4A7C15ull) ^ (std::size_t{k[1]} * 0xC2B2AE3D27D4EB4Full) ^
-             (std::size_t{k[2]} * 0x165667B19E3779F9ull);
-    }
-  };
+  /// The packed face with these vertices, or kNone.
+  Index find_face(const std::array<VertId, 3>& face) const;
 
   modify::MeshEditor editor_;
   modify::Cavity cavity_;
@@ -80,8 +77,9 @@ class Delaunay3d {
   TetId last_ = 0;
   std::uint64_t rng_ = 0x9E3779B97F4A7C15ull;
   std::size_t walk_steps_ = 0;
-  std::unordered_set<std::array<VertId, 3>, TripleHash> protected_;
+  std::size_t protected_count_ = 0;
   std::vector<TetId> stack_;
+  mutable std::vector<TetId> ball_;
 };
 
 }  // namespace cm::generate

@@ -144,7 +144,8 @@ Vec3 circumcentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMeshOptions& o, VolumeMeshStats& st) {
   auto& m = dt.mesh();
   auto& ed = dt.editor();
-  for (const auto& t : m.tris) dt.protect(t.verts);
+  for (const auto& t : m.tris)
+    if (!dt.protect(t.verts)) throw InternalError("interior refinement: a recovered boundary triangle is no face");
   std::vector<TetId> queue;
   for (TetId t = 0; t < m.tet2verts.size(); ++t)
     if (!ed.is_dead(t)) queue.push_back(t);
@@ -174,10 +175,10 @@ void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMe
       // Too close to the boundary: the new tets against it would be flat.
       bool close = false;
       for (int f = 0; f < 4 && !close; ++f) {
+        if (!ed.face_marked(mesh::pack_face(home, f))) continue;
         const auto& hv = m.tet2verts[home];
         const auto& fv = mesh::kFaceVerts[f];
         const std::array<VertId, 3> face{hv[fv[0]], hv[fv[1]], hv[fv[2]]};
-        if (!dt.is_protected(face)) continue;
         const Vec3 n = (m.coords[face[1]] - m.coords[face[0]]).cross(m.coords[face[2]] - m.coords[face[0]]);
         close = std::abs(n.normalized().dot(cc - m.coords[face[0]])) < o.boundary_clearance * h;
       }

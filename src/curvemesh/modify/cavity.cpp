@@ -62,7 +62,8 @@ std::span<const CavityFace> Cavity::compute_boundary(const MeshEditor& ed) {
       const Index across = m.tet2adj[4 * t + f];
       if (across != kNone && ed.marked(mesh::face_tet(across))) continue;
       const auto& fv = mesh::kFaceVerts[f];
-      boundary_.push_back({{tv[fv[0]], tv[fv[1]], tv[fv[2]]}, mesh::pack_face(t, f), across});
+      boundary_.push_back({{tv[fv[0]], tv[fv[1]], tv[fv[2]]}, mesh::pack_face(t, f), across,
+                           ed.face_marked(mesh::pack_face(t, f))});
     }
   }
   return boundary_;
@@ -116,7 +117,9 @@ std::span<const TetId> rebuild(MeshEditor& ed, Cavity& cav, std::span<const NewT
       const Index other = find_or_insert(sorted({nt.verts[fv[0]], nt.verts[fv[1]], nt.verts[fv[2]]}), here);
       if (other == kNone) continue;
       if (other & kBoundaryBit) {
-        const Index outside = cav.boundary_[other & ~kBoundaryBit].outside;
+        const CavityFace& bf = cav.boundary_[other & ~kBoundaryBit];
+        const Index outside = bf.outside;
+        if (bf.marked) ed.set_face_mark_one_side(here, true);
         m.tet2adj[here] = outside;
         if (outside != kNone) m.tet2adj[outside] = here;
       } else {
@@ -189,6 +192,7 @@ std::span<const TetId> fill_star(MeshEditor& ed, Cavity& cav, VertId p) {
     cav.created_.push_back(t);
     const int fb = mesh::face_index(bf.inside);
     m.tet2adj[mesh::pack_face(t, fb)] = bf.outside;
+    if (bf.marked) ed.set_face_mark_one_side(mesh::pack_face(t, fb), true);
     if (bf.outside != kNone) m.tet2adj[bf.outside] = mesh::pack_face(t, fb);
     for (int f = 0; f < 4; ++f) {
       if (f == fb) continue;

@@ -40,6 +40,7 @@ struct CavityFace {
   std::array<VertId, 3> verts;
   Index inside = kNone;
   Index outside = kNone;
+  bool marked = false;  ///< a protected face (see MeshEditor::face_marked)
 };
 
 /// A tet to create, with its region tag.

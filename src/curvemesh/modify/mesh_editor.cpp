@@ -33,8 +33,25 @@ TetId MeshEditor::allocate(const std::array<VertId, 4>& v, std::int32_t region) 
   return t;
 }
 
+void MeshEditor::mark_face(Index packed) {
+  set_face_mark_one_side(packed, true);
+  const Index other = m_->tet2adj[packed];
+  if (other != kNone) set_face_mark_one_side(other, true);
+}
+
+void MeshEditor::set_face_mark_one_side(Index packed, bool on) {
+  const TetId t = mesh::face_tet(packed);
+  if (face_marks_.size() <= t) {
+    if (!on) return;
+    face_marks_.resize(m_->tet2verts.size(), 0);
+  }
+  const auto bit = static_cast<std::uint8_t>(1u << mesh::face_index(packed));
+  face_marks_[t] = on ? (face_marks_[t] | bit) : (face_marks_[t] & ~bit);
+}
+
 void MeshEditor::release(TetId t) {
   m_->tet2verts[t][0] = kNone;
+  if (t < face_marks_.size()) face_marks_[t] = 0;
   free_.push_back(t);
 }
 
@@ -58,6 +75,7 @@ std::vector<TetId> MeshEditor::compact() {
     if (nt == kNone) continue;
     m.tet2verts[nt] = m.tet2verts[t];
     m.tet_region[nt] = m.tet_region[t];
+    if (t < face_marks_.size()) face_marks_[nt] = face_marks_[t];
     for (int f = 0; f < 4; ++f) {
       const Index a = m.tet2adj[4 * t + f];
       m.tet2adj[4 * nt + f] = a == kNone ? kNone : mesh::pack_face(remap[mesh::face_tet(a)], mesh::face_index(a));
@@ -65,6 +83,7 @@ std::vector<TetId> MeshEditor::compact() {
   }
   m.tet2verts.resize(next);
   m.tet_region.resize(next);
+  if (face_marks_.size() > next) face_marks_.resize(next);
   m.tet2adj.resize(4 * static_cast<std::size_t>(next));
   m.vert2tet.assign(m.coords.size(), kNone);
   for (TetId t = 0; t < next; ++t)

@@ -53,6 +53,18 @@ class MeshEditor {
   void mark(TetId t) { grow_stamps(); stamps_[t] = epoch_; }
   bool marked(TetId t) const { return t < stamps_.size() && stamps_[t] == epoch_; }
 
+  /// Face marks: a protected face (a boundary triangle a cavity must not
+  /// cross or remove). Stored on both tets sharing the face; cavity rebuilds
+  /// carry marks of the cavity's boundary faces over to the new tets.
+  bool face_marked(Index packed) const {
+    const TetId t = mesh::face_tet(packed);
+    return t < face_marks_.size() && (face_marks_[t] >> mesh::face_index(packed) & 1u);
+  }
+  /// Marks the face on both sides.
+  void mark_face(Index packed);
+  /// Sets or clears the mark on this side only (used by rebuild).
+  void set_face_mark_one_side(Index packed, bool on);
+
   void set_hook(RebuildHook hook) { hook_ = std::move(hook); }
   const RebuildHook& hook() const { return hook_; }
 
@@ -68,6 +80,7 @@ class MeshEditor {
   mesh::TetMesh* m_;
   std::vector<TetId> free_;
   std::vector<std::uint32_t> stamps_;
+  std::vector<std::uint8_t> face_marks_;
   std::uint32_t epoch_ = 1;
   RebuildHook hook_;
 };
