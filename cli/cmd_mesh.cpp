@@ -13,6 +13,7 @@
 #include "curvemesh/generate/boundary_mesh.hpp"
 #include "curvemesh/generate/volume_mesh.hpp"
 #include "curvemesh/mesh/validate.hpp"
+#include "curvemesh/optimize/improve.hpp"
 #include "curvemesh/quality/measures.hpp"
 #include "curvemesh/quality/statistics.hpp"
 #include "exit_codes.hpp"
@@ -30,6 +31,7 @@ struct MeshCliOptions {
   SizeFlags size;
   ModelFlags model_flags;
   bool quiet = false;
+  bool no_optimize = false;
 };
 
 int run_volume(const MeshCliOptions& o);
@@ -125,7 +127,9 @@ int run_volume(const MeshCliOptions& o) {
   const size::SizeFieldResult sf = size::build_size_field(*model, so);
   const double size_s = step.seconds();
   generate::VolumeMeshStats st;
-  const mesh::TetMesh m = generate::mesh_volume(*model, *sf.field, {}, &st);
+  mesh::TetMesh m = generate::mesh_volume(*model, *sf.field, {}, &st);
+  optimize::ImproveStats opt;
+  if (!o.no_optimize) opt = optimize::improve_quality(m);
   step.reset();
   const auto valid = mesh::validate(m, mesh::Level::kFull);
   const generate::BoundaryReport rep = generate::check_boundary(*model, m, *sf.field);
@@ -173,6 +177,13 @@ int run_volume(const MeshCliOptions& o) {
                 {"vertices_off_entity", rep.vertices_off_entity},
                 {"folded_triangles", rep.folded_triangles}};
   j["volume"] = {{"model", vol_model}, {"mesh", vol_mesh}};
+  j["optimization"] = {{"edge_removals", opt.edge_removals},
+                       {"face_swaps", opt.face_swaps},
+                       {"relocations", opt.relocations},
+                       {"passes", opt.passes},
+                       {"mean_ratio_min_before", opt.min_before},
+                       {"below_0_3_before", opt.below_before},
+                       {"below_0_3_after", opt.below_after}};
   j["quality"] = {{"mean_ratio_min", qs.min},
                   {"mean_ratio_mean", qs.mean},
                   {"min_dihedral_deg", ds.min},
@@ -185,6 +196,7 @@ int run_volume(const MeshCliOptions& o) {
                   {"recovery", st.recovery_seconds},
                   {"regions", st.classify_seconds},
                   {"interior", st.refine_seconds},
+                  {"optimize", opt.seconds},
                   {"check", check_s},
                   {"write", write_s},
                   {"total", total.seconds()}};
@@ -198,6 +210,11 @@ int run_volume(const MeshCliOptions& o) {
                "faces) in {} rounds\n",
                st.recovery.missing_edges_initial, st.recovery.missing_triangles_initial, steiner,
                st.recovery.steiner_on_edges, st.recovery.steiner_on_faces, st.recovery.rounds);
+    if (!o.no_optimize)
+      fmt::print("optimization: {} edge removals, {} face swaps, {} relocations in {} passes; tets with mean ratio "
+                 "< 0.3: {} -> {}; min {:.3f} -> {:.3f}\n",
+                 opt.edge_removals, opt.face_swaps, opt.relocations, opt.passes, opt.below_before, opt.below_after,
+                 opt.min_before, opt.min_after);
     fmt::print("quality: mean ratio min {:.3f} mean {:.3f}; min dihedral {:.2f} deg\n", qs.min, qs.mean, ds.min);
     fmt::print("volume: mesh {:.6g}, model {:.6g} (relative difference {:.2e})\n", vol_mesh, vol_model,
                vol_model > 0 ? (vol_mesh - vol_model) / vol_model : 0.0);
@@ -209,9 +226,9 @@ int run_volume(const MeshCliOptions& o) {
     for (std::size_t i = 0; i < std::min<std::size_t>(valid.issues.size(), 5); ++i)
       fmt::print("  {}\n", valid.issues[i].message);
     fmt::print("time: load {:.2f} s, size field {:.2f} s, boundary {:.2f} s, delaunay {:.2f} s, recovery {:.2f} s, "
-               "regions {:.2f} s, interior {:.2f} s, check {:.2f} s, write {:.2f} s, total {:.2f} s\n",
+               "regions {:.2f} s, interior {:.2f} s, optimize {:.2f} s, check {:.2f} s, write {:.2f} s, total {:.2f} s\n",
                load_s, size_s, st.boundary_seconds, st.delaunay_seconds, st.recovery_seconds, st.classify_seconds,
-               st.refine_seconds, check_s, write_s, total.seconds());
+               st.refine_seconds, opt.seconds, check_s, write_s, total.seconds());
     if (!o.output.empty()) fmt::print("wrote {}\n", o.output);
   }
   return ok ? kExitOk : kExitInvalidMesh;
@@ -229,6 +246,7 @@ void add_mesh_command(CLI::App& app, Runner& runner) {
   cmd->add_option("--json", o->json_path, "Write the summary as JSON");
   add_size_flags(cmd, o->size);
   add_model_flags(cmd, o->model_flags);
+  cmd->add_flag("--no-optimize", o->no_optimize, "Volume mesh: skip the quality optimization (swaps, smoothing)");
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
   cmd->footer(
       "Exit code 0 when the mesh passes its checks (volume: every tet positive, conforming,\n"

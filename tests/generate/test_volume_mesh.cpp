@@ -13,6 +13,7 @@
 #include "curvemesh/geom_occ/load.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/validate.hpp"
+#include "curvemesh/optimize/improve.hpp"
 #include "curvemesh/size/build.hpp"
 
 using namespace cm;
@@ -131,5 +132,20 @@ TEST(VolumeMesh, SharedModels) {
     expect_valid(r);
     const double v = model_volume(*r.model);
     EXPECT_NEAR(mesh_volume_of(r.m), v, 0.03 * v);
+  }
+}
+
+TEST(VolumeMesh, OptimizationRemovesSliversAndKeepsEverythingElse) {
+  for (const char* spec : {"builtin:torus", "builtin:part"}) {
+    SCOPED_TRACE(spec);
+    auto r = mesh_model(spec);
+    const double vol = mesh_volume_of(r.m);
+    const auto tris = r.m.tris;
+    const auto st = optimize::improve_quality(r.m);
+    expect_valid(r);
+    EXPECT_NEAR(mesh_volume_of(r.m), vol, 1e-10 * vol);
+    EXPECT_EQ(r.m.tris.size(), tris.size());
+    EXPECT_GT(st.min_after, st.min_before);
+    EXPECT_LT(st.below_after, st.below_before);
   }
 }

@@ -1,0 +1,167 @@
+// Volume meshing end to end, side by side with `gmsh -3` on the same model
+// and sizes (curvature sizing on both: our default alpha = 0.04, about 20
+// edges per circle; Gmsh's Mesh.MeshSizeFromCurvature 20; the same hmax and
+// hmin). Each mesher runs in its own child process so its wall time and peak
+// resident memory are its own. Prints one line per model: tets, seconds, peak
+// RSS bytes per tet, min / mean tet mean ratio and min dihedral angle for
+// both, and Gmsh's time over ours. Ours is what `curvemesh mesh` does:
+// volume mesh then quality optimization; Gmsh's default also optimizes.
+//   bench_volume                 every shared model, default sizes
+//   bench_volume MODEL [HMAX]    one model (e.g. t20_data.step 1.2)
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "curvemesh/generate/volume_mesh.hpp"
+#include "curvemesh/geom_occ/load.hpp"
+#include "curvemesh/io/mesh_io.hpp"
+#include "curvemesh/mesh/validate.hpp"
+#include "curvemesh/optimize/improve.hpp"
+#include "curvemesh/quality/measures.hpp"
+#include "curvemesh/size/build.hpp"
+#include "shared_models.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Row {
+  std::size_t tets = 0;
+  double seconds = 0, min_q = 0, mean_q = 0, min_dihedral = 0;
+  long peak_rss = 0;
+  bool ok = false, valid = false;
+  std::string error;
+};
+
+void measure(const cm::mesh::TetMesh& m, Row& r) {
+  r.tets = m.num_tets();
+  double sum = 0, lo = 1, dmin = 180;
+  for (cm::TetId t = 0; t < m.num_tets(); ++t) {
+    const auto q = cm::quality::evaluate_tet(m, t);
+    sum += q.mean_ratio;
+    lo = std::min(lo, q.mean_ratio);
+    dmin = std::min(dmin, q.min_dihedral);
+  }
+  r.min_q = lo;
+  r.mean_q = r.tets ? sum / static_cast<double>(r.tets) : 0;
+  r.min_dihedral = dmin;
+}
+
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+constexpr int kGmshSeconds = 600;
+
+// Runs `work` in a child process; returns its exit status and peak RSS.
+template <class F>
+int in_child(F&& work, long& peak_rss) {
+  std::fflush(stdout);
+  const pid_t pid = fork();
+  if (pid == 0) _exit(work());
+  int status = 0;
+  rusage ru{};
+  wait4(pid, &status, 0, &ru);
+  peak_rss = ru.ru_maxrss * 1024;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<fs::path> files;
+  double hmax_arg = 0;
+  if (argc >= 2) {
+    files.emplace_back(fs::exists(argv[1]) ? fs::path(argv[1]) : cm::bench::models_dir() / argv[1]);
+    if (argc >= 3) hmax_arg = std::atof(argv[2]);
+  } else {
+    files = cm::bench::model_files();
+  }
+  const bool have_gmsh = std::system("gmsh --version > /dev/null 2>&1") == 0;
+  const fs::path tmp = fs::temp_directory_path() / fmt::format("curvemesh_bench_volume_{}", getpid());
+  fs::create_directories(tmp);
+  fmt::print("{:<36} {:>9} {:>7} {:>6} {:>6} {:>6} {:>6} | {:>9} {:>7} {:>6} {:>6} {:>6} {:>6} | {:>7}\n", "model",
+             "tets", "s", "B/tet", "minq", "meanq", "mindih", "gmsh tets", "s", "B/tet", "minq", "meanq", "mindih",
+             "gmsh/us");
+  for (const fs::path& f : files) {
+    Row ours, theirs;
+    const fs::path result = tmp / "ours.txt";
+    const fs::path sizes = tmp / "sizes.txt";
+    const double t0 = now();
+    const int rc = in_child(
+        [&] {
+          try {
+            const auto model = cm::geom_occ::load_model(f.string());
+            cm::size::SizeOptions so;
+            so.hmax = hmax_arg;
+            const auto sf = cm::size::build_size_field(*model, so);
+            auto m = cm::generate::mesh_volume(*model, *sf.field);
+            cm::optimize::improve_quality(m);  // as `curvemesh mesh` does
+            Row r;
+            measure(m, r);
+            r.valid = cm::mesh::validate(m, cm::mesh::Level::kFull).valid();
+            std::ofstream(result) << r.tets << ' ' << r.min_q << ' ' << r.mean_q << ' ' << r.min_dihedral << ' '
+                                  << r.valid << '\n';
+            std::ofstream(sizes) << sf.hmin << ' ' << sf.hmax << '\n';
+            return 0;
+          } catch (const std::exception& e) {
+            std::ofstream(result) << "error " << e.what() << '\n';
+            return 1;
+          }
+        },
+        ours.peak_rss);
+    ours.seconds = now() - t0;  // includes the quality measurement and validation: a small part
+    {
+      std::ifstream in(result);
+      if (rc == 0) {
+        in >> ours.tets >> ours.min_q >> ours.mean_q >> ours.min_dihedral >> ours.valid;
+        ours.ok = true;
+      } else {
+        std::getline(in, ours.error);
+      }
+    }
+    if (!ours.ok) {
+      fmt::print("{:<36} error: {}\n", f.filename().string(), ours.error.empty() ? "crashed" : ours.error);
+      continue;
+    }
+    double hmin = 0, hmax = 0;
+    std::ifstream(sizes) >> hmin >> hmax;
+    if (have_gmsh) {
+      const fs::path out = tmp / "gmsh.msh";
+      const std::string cmd = fmt::format(
+          "timeout {} gmsh -3 '{}' -o '{}' -format msh41 -setnumber Mesh.MeshSizeMax {} -setnumber Mesh.MeshSizeMin {} "
+          "-setnumber Mesh.MeshSizeFromCurvature 20 -setnumber General.Verbosity 0 > /dev/null 2>&1",
+          kGmshSeconds, f.string(), out.string(), hmax, hmin);
+      const double g0 = now();
+      const int grc = in_child([&] { return WEXITSTATUS(std::system(cmd.c_str())); }, theirs.peak_rss);
+      theirs.seconds = now() - g0;
+      if (grc == 0) {
+        try {
+          measure(cm::io::read_mesh(out.string()), theirs);
+          theirs.ok = true;
+        } catch (const std::exception&) {
+        }
+      }
+    }
+    auto bpt = [](const Row& r) { return r.tets ? static_cast<double>(r.peak_rss) / static_cast<double>(r.tets) : 0; };
+    fmt::print("{:<36} {:>9} {:>7.2f} {:>6.0f} {:>6.3f} {:>6.3f} {:>6.2f} | ", f.filename().string(), ours.tets,
+               ours.seconds, bpt(ours), ours.min_q, ours.mean_q, ours.min_dihedral);
+    if (theirs.ok)
+      fmt::print("{:>9} {:>7.2f} {:>6.0f} {:>6.3f} {:>6.3f} {:>6.2f} | {:>7.2f}{}\n", theirs.tets, theirs.seconds,
+                 bpt(theirs), theirs.min_q, theirs.mean_q, theirs.min_dihedral, theirs.seconds / ours.seconds,
+                 ours.valid ? "" : "  (ours INVALID)");
+    else
+      fmt::print("{:>9}{}\n", !have_gmsh ? "no gmsh" : theirs.seconds >= kGmshSeconds ? "gmsh timed out" : "gmsh failed",
+                 ours.valid ? "" : "  (ours INVALID)");
+  }
+  fs::remove_all(tmp);
+  return 0;
+}
