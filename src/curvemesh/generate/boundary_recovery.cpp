@@ -176,7 +176,6 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   std::size_t surface_verts = 0;
   for (VertId v = 0; v < m.coords.size(); ++v) surface_verts += m.vert_class[v].dim >= 0 && m.vert_class[v].dim <= 2;
   const auto max_steiner = static_cast<std::size_t>(o.max_steiner_factor * static_cast<double>(surface_verts)) + 1000;
-  std::vector<TetId> scratch;
   std::vector<std::pair<VertId, VertId>> to_split;
   int last_face = 0;
   // After the first round only simplices touching a vertex of a new tet can
@@ -199,25 +198,22 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     std::vector<char> checking(dirty.size(), 0);
     checking.swap(dirty);
     auto check = [&](VertId v) { return v < checking.size() && checking[v]; };
-    // A full check (the first round) reads every tet once instead of walking
-    // a ball per surface simplex: boundary-only Delaunay balls are large.
+    // Read every tet once rather than walking a ball per surface simplex:
+    // balls of a boundary-only Delaunay mesh can hold thousands of tets.
+    // Only simplices at a vertex under check are collected.
     std::unordered_set<std::uint64_t> all_edges;
     std::unordered_set<Triple, TripleHash> all_faces;
-    const bool bulk = st.rounds == 0;
-    if (bulk) {
-      all_edges.reserve(8 * m.tet2verts.size());
-      all_faces.reserve(3 * m.tet2verts.size());
-      for (TetId t = 0; t < m.tet2verts.size(); ++t) {
-        if (dt.editor().is_dead(t)) continue;
-        const auto& tv = m.tet2verts[t];
-        for (const auto& e : mesh::kTetEdges) all_edges.insert(edge_key(tv[e[0]], tv[e[1]]));
-        for (const auto& f : mesh::kFaceVerts) all_faces.insert(sorted3({tv[f[0]], tv[f[1]], tv[f[2]]}));
-      }
+    for (TetId t = 0; t < m.tet2verts.size(); ++t) {
+      if (dt.editor().is_dead(t)) continue;
+      const auto& tv = m.tet2verts[t];
+      if (!check(tv[0]) && !check(tv[1]) && !check(tv[2]) && !check(tv[3])) continue;
+      for (const auto& e : mesh::kTetEdges)
+        if (check(tv[e[0]]) || check(tv[e[1]])) all_edges.insert(edge_key(tv[e[0]], tv[e[1]]));
+      for (const auto& f : mesh::kFaceVerts)
+        if (check(tv[f[0]]) || check(tv[f[1]]) || check(tv[f[2]])) all_faces.insert(sorted3({tv[f[0]], tv[f[1]], tv[f[2]]}));
     }
-    auto edge_in = [&](VertId a, VertId b) { return bulk ? all_edges.count(edge_key(a, b)) != 0 : has_edge(m, a, b, scratch); };
-    auto face_in = [&](const std::array<VertId, 3>& v) {
-      return bulk ? all_faces.count(sorted3(v)) != 0 : has_face(m, v[0], v[1], v[2], scratch);
-    };
+    auto edge_in = [&](VertId a, VertId b) { return all_edges.count(edge_key(a, b)) != 0; };
+    auto face_in = [&](const std::array<VertId, 3>& v) { return all_faces.count(sorted3(v)) != 0; };
     for (const auto& [key, tris] : surf.edges()) {
       const auto a = static_cast<VertId>(key >> 32), b = static_cast<VertId>(key & 0xFFFFFFFFu);
       if (!check(a) && !check(b)) continue;
@@ -231,29 +227,30 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
           !edge_in(s.verts[0], s.verts[1]))
         to_split.emplace_back(s.verts[0], s.verts[1]);
     const std::size_t missing_edges = to_split.size();
-    if (missing_edges != 0) {
-      // Triangles are checked once the edges are in: keep this round's set.
-      if (dirty.size() < checking.size()) dirty.resize(checking.size(), 0);
-      for (std::size_t v = 0; v < checking.size(); ++v) dirty[v] |= checking[v];
-    } else {
-      // Edges all present: a missing triangle gets its longest edge split.
-      for (const auto& t : m.tris) {
-        const auto& v = t.verts;
-        if (!check(v[0]) && !check(v[1]) && !check(v[2])) continue;
-        if (face_in(v)) continue;
-        ++missing_tris;
-        last_face = t.face_tag;
-        int longest = 0;
-        double best = -1;
-        for (int e = 0; e < 3; ++e) {
-          const double l = (m.coords[v[mesh::kTriEdges[e][0]]] - m.coords[v[mesh::kTriEdges[e][1]]]).squaredNorm();
-          if (l > best) {
-            best = l;
-            longest = e;
-          }
-        }
-        to_split.emplace_back(v[mesh::kTriEdges[longest][0]], v[mesh::kTriEdges[longest][1]]);
+    // Triangles are checked every round but split only once the edges are
+    // in (a missing edge usually explains its triangles); deferred ones keep
+    // their vertices under check.
+    for (const auto& t : m.tris) {
+      const auto& v = t.verts;
+      if (!check(v[0]) && !check(v[1]) && !check(v[2])) continue;
+      if (face_in(v)) continue;
+      ++missing_tris;
+      if (missing_edges != 0) {
+        if (dirty.size() < checking.size()) dirty.resize(checking.size(), 0);
+        for (VertId x : v) dirty[x] = 1;
+        continue;
       }
+      last_face = t.face_tag;
+      int longest = 0;
+      double best = -1;
+      for (int e = 0; e < 3; ++e) {
+        const double l = (m.coords[v[mesh::kTriEdges[e][0]]] - m.coords[v[mesh::kTriEdges[e][1]]]).squaredNorm();
+        if (l > best) {
+          best = l;
+          longest = e;
+        }
+      }
+      to_split.emplace_back(v[mesh::kTriEdges[longest][0]], v[mesh::kTriEdges[longest][1]]);
     }
     if (st.rounds == 0) {
       st.missing_edges_initial = missing_edges;
@@ -272,6 +269,9 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     std::sort(to_split.begin(), to_split.end());
     for (const auto& [a, b] : to_split) {
       if (!surf.exists(a, b)) continue;  // already split this round
+      // A cascade (surfaces meeting at a tiny angle or nearly touching) can
+      // multiply the splits of one round: stop as soon as the budget is spent.
+      if (st.steiner_on_edges + st.steiner_on_faces > max_steiner) break;
       const VertId p = surf.split(a, b, st);
       const auto r = dt.insert(p, m.vert2tet[a]);
       if (r.refusal != modify::Refusal::kNone)
