@@ -3,8 +3,11 @@
 // cospherical: the perturbation decides all ties).
 //   bench_delaunay [random N]... [grid K]...   (default: random 1000000, grid 100)
 // Prints one line per run: kind, points, tets, seconds, points/s, mesh bytes
-// per tet (arrays' capacity) and the process's peak resident bytes per tet.
+// per tet (arrays' capacity) and the process's peak resident bytes per tet;
+// then the CPU time (the machine may be shared: compare that one), the points
+// per CPU second, and how many predicate calls fell through the filter.
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -14,9 +17,16 @@
 
 #include <fmt/format.h>
 
+#include "curvemesh/core/predicates.hpp"
 #include "curvemesh/generate/delaunay3d.hpp"
 
 namespace {
+
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 long peak_rss_bytes() {
   std::ifstream f("/proc/self/status");
@@ -38,13 +48,20 @@ void run(const std::string& kind, std::vector<cm::Vec3> pts) {
   }
   std::vector<cm::VertId> ids(n);
   for (std::size_t i = 0; i < n; ++i) ids[i] = static_cast<cm::VertId>(i);
+  cm::predicates::exact_stats() = {};
+  const double c0 = cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   cm::generate::Delaunay3d dt(m, lo, hi);
   dt.insert_all(ids);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = cpu_seconds() - c0;
+  const auto ex = cm::predicates::exact_stats();
   const std::size_t tets = dt.editor().live_tets();
   fmt::print("{:<8} points {:>9}  tets {:>10}  {:7.2f} s  {:9.0f} points/s  mesh {:5.1f} B/tet  peak RSS {:5.1f} B/tet\n",
              kind, n, tets, s, n / s, double(m.memory_bytes()) / tets, double(peak_rss_bytes()) / tets);
+  fmt::print("         cpu {:7.2f} s  {:9.0f} points/cpu-s  exact stage: orient3d {}  insphere {}  "
+             "walk steps {:.2f}/point\n",
+             cpu, n / cpu, ex.orient3d, ex.insphere, double(dt.exact_walk_steps()) / n);
   std::fflush(stdout);
 }
 

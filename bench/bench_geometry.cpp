@@ -1,14 +1,19 @@
-// The OpenCASCADE model: load time per shared model, and the point-query
+// The OpenCASCADE model: load time per shared model, the point-query
 // throughput the mesher depends on (curvature and closest point) on the
-// largest freeform (B-spline) face of t20_data.step. items_per_second is
-// queries per second. Models are read from $CM_MODELS_DIR, by default
+// largest freeform (B-spline) face of t20_data.step, and classify_point (the
+// point-in-solid test behind sizes on regions) on a few shared models, warm
+// (the region's classifier already built) and cold (the first call on a
+// freshly loaded model, which builds it). items_per_second is queries per
+// second. Models are read from $CM_MODELS_DIR, by default
 // ../../shared/models next to this source file. Run with
 // --benchmark_format=json for machine-readable records.
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <random>
 #include <string>
 #include <vector>
@@ -112,6 +117,59 @@ BENCHMARK(BM_ClosestPointGlobal)->ThreadRange(1, 2)->UseRealTime();
 BENCHMARK(BM_ClosestPointWithHint);
 BENCHMARK(BM_ContainsParam);
 
+// The region of largest volume (ring.brep's region 1 is a small ring).
+int largest_region(const cm::geom::Model& model) {
+  int best = 1;
+  for (int r = 2; r <= model.count(3); ++r)
+    if (model.volume(r) > model.volume(best)) best = r;
+  return best;
+}
+
+// Uniform probes in the model's box: what the size octree asks.
+std::vector<Vec3> box_probes(const cm::geom::Model& model, std::size_t n) {
+  const cm::geom::BoundingBox b = model.bounding_box();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<Vec3> probes(n);
+  for (Vec3& p : probes) p = b.min + Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(b.size());
+  return probes;
+}
+
+void BM_ClassifyPoint(benchmark::State& state, const std::string& path) {
+  static std::mutex mutex;
+  static std::map<std::string, std::unique_ptr<cm::geom::Model>> models;
+  const cm::geom::Model* model = nullptr;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    auto& slot = models[path];
+    if (!slot) slot = cm::geom_occ::load_model(path);
+    model = slot.get();
+  }
+  const std::vector<Vec3> probes = box_probes(*model, 4096);
+  const int region = largest_region(*model);
+  std::size_t i = static_cast<std::size_t>(state.thread_index()) * 331;
+  model->classify_point(region, probes[i % probes.size()]);  // prepares the region, untimed
+  std::size_t inside = 0;
+  for (auto _ : state) {
+    inside += model->classify_point(region, probes[i++ % probes.size()]) != cm::geom::Containment::kOutside;
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["faces"] = benchmark::Counter(model->count(2), benchmark::Counter::kAvgThreads);
+  state.counters["inside_fraction"] = benchmark::Counter(
+      double(inside) / double(std::max<std::int64_t>(1, state.iterations())), benchmark::Counter::kAvgThreads);
+}
+
+void BM_ClassifyPointCold(benchmark::State& state, const std::string& path) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    const auto model = cm::geom_occ::load_model(path);
+    const Vec3 centre = 0.5 * (model->bounding_box().min + model->bounding_box().max);
+    const int region = largest_region(*model);
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(model->classify_point(region, centre));
+  }
+}
+
 void BM_Load(benchmark::State& state, const std::string& path) {
   int faces = 0;
   for (auto _ : state) {
@@ -129,6 +187,19 @@ const int kRegistered = [] {
         ->Unit(benchmark::kMillisecond)
         ->Iterations(2)
         ->UseRealTime();
+  }
+  for (const char* name :
+       {"t20_data.step", "Zylkopf.stp", "SampleCrankshaft4A.stp", "917_fusee.stp", "ring.brep", "dlr_f6.brep"}) {
+    const fs::path f = cm::bench::models_dir() / name;
+    if (!fs::exists(f)) continue;
+    benchmark::RegisterBenchmark((std::string("BM_ClassifyPoint/") + name).c_str(), BM_ClassifyPoint, f.string())
+        ->Unit(benchmark::kMicrosecond)
+        ->ThreadRange(1, 2)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark((std::string("BM_ClassifyPointCold/") + name).c_str(), BM_ClassifyPointCold,
+                                 f.string())
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(2);
   }
   return static_cast<int>(files.size());
 }();

@@ -157,7 +157,8 @@ void add_size_command(CLI::App& app, Runner& runner) {
       "4 size field, 5 gradation, 6 hmin, 7 short edge, 8 narrow face.\n"
       "\nExamples:\n  curvemesh size part.step -o size.vtu\n"
       "  curvemesh size builtin:torus --curv-eps 0.01 --hgrad 1.2 -o size.vtu --samples-out samples.vtu\n"
-      "  curvemesh size part.step --size face:3=0.5 --size-expr '0.2 + 0.1*abs(z)'");
+      "  curvemesh size part.step --size face:3=0.5 --size-expr '0.2 + 0.1*abs(z)'\n"
+      "  curvemesh size assembly.step --size region:2=1.5 -o size.vtu");
   cmd->callback([&runner, o] { runner = [o] { return run_size(*o); }; });
 }
 

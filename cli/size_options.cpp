@@ -1,5 +1,6 @@
 #include "size_options.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <map>
 #include <regex>
@@ -17,15 +18,18 @@ namespace cm::cli {
 
 namespace {
 
-// "face:3=0.5", "edge:12=0.1", "vertex:4=0.01" or "2:3=0.5".
+// "face:3=0.5", "edge:12=0.1", "vertex:4=0.01", "region:2=1.5" or "2:3=0.5".
+// Whether the tag exists is build_size_field's check, once the model is read.
 std::pair<geom::EntityRef, double> parse_entity_size(const std::string& spec) {
-  static const std::regex re(R"(^\s*(vertex|edge|face|0|1|2)\s*:\s*(\d+)\s*=\s*([^\s]+)\s*$)");
+  static const std::regex re(R"(^\s*(vertex|edge|face|region|0|1|2|3)\s*:\s*(\d+)\s*=\s*([^\s]+)\s*$)");
   std::smatch m;
   if (!std::regex_match(spec, m, re))
     throw InputError("--size", -1, -1,
-                     fmt::format("'{}': expected DIM:TAG=H with DIM vertex, edge or face (or 0, 1, 2), e.g. face:3=0.5",
+                     fmt::format("'{}': expected DIM:TAG=H with DIM vertex, edge, face or region (or 0-3), "
+                                 "e.g. face:3=0.5",
                                  spec));
-  static const std::map<std::string, int> dims = {{"vertex", 0}, {"edge", 1}, {"face", 2}, {"0", 0}, {"1", 1}, {"2", 2}};
+  static const std::map<std::string, int> dims = {{"vertex", 0}, {"edge", 1}, {"face", 2}, {"region", 3},
+                                                  {"0", 0},      {"1", 1},    {"2", 2},    {"3", 3}};
   double h = 0;
   try {
     std::size_t used = 0;
@@ -36,7 +40,12 @@ std::pair<geom::EntityRef, double> parse_entity_size(const std::string& spec) {
   }
   if (!(h > 0) || !std::isfinite(h))
     throw InputError("--size", -1, -1, fmt::format("'{}': the size must be finite and > 0", spec));
-  return {{dims.at(m[1].str()), std::stoi(m[2].str())}, h};
+  int tag = 0;
+  const std::string digits = m[2].str();
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), tag);
+  if (ec != std::errc() || end != digits.data() + digits.size() || tag < 1)
+    throw InputError("--size", -1, -1, fmt::format("'{}': the tag must be an integer >= 1", spec));
+  return {{dims.at(m[1].str()), tag}, h};
 }
 
 std::shared_ptr<const size::SizeField> read_background(const SizeFlags& o, double hgrad,
@@ -97,7 +106,9 @@ void add_size_flags(CLI::App* cmd, SizeFlags& f) {
   alpha->excludes(off);
   cmd->add_flag("--directional", f.directional,
                 "Sizes along each principal direction on faces (anisotropic surface metric)");
-  cmd->add_option("--size", f.entity_sizes, "Size on a model entity: DIM:TAG=H, e.g. face:3=0.5 (repeatable)");
+  cmd->add_option("--size", f.entity_sizes,
+                  "Size on a model entity: DIM:TAG=H with DIM vertex, edge, face or region, e.g. face:3=0.5; "
+                  "a region gets H everywhere inside it and on its boundary (repeatable)");
   cmd->add_option("--size-expr", f.expressions,
                   "Size as a function of x, y, z, e.g. '0.1 + 0.05*sqrt(x^2+y^2)' (repeatable)");
   auto* bg = cmd->add_option("--background", f.background_mesh, "Background tet mesh for --background-sol");

@@ -57,6 +57,36 @@ TEST(CliSize, EntitySizeExpressionAndBackgroundAreSources) {
   EXPECT_GT(j["octree"]["leaves_by_source"]["size field"].get<int>(), 0);
 }
 
+TEST(CliSize, RegionSizeRefinesTheNamedRegionOnly) {
+  const std::string dir = cm::test::make_temp_dir("size");
+  // builtin:blocks: two unit cubes side by side along x, sharing x = 1.
+  auto r = run_cli("size builtin:blocks --no-curvature --hmax 0.4 --size region:1=0.05 --json " + dir +
+                   "/one.json -o " + dir + "/one.vtu -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto j = nlohmann::json::parse(cm::test::read_text(dir + "/one.json"));
+  // Inside: the region field; on its faces: the entity-size samples.
+  EXPECT_GT(j["octree"]["leaves_by_source"]["size field"].get<int>(), 0);
+  EXPECT_GT(j["octree"]["leaves_by_source"]["entity size"].get<int>(), 0);
+  EXPECT_GT(j["octree"]["leaves_by_source"]["gradation"].get<int>(), 0);
+  const int one_region = j["octree"]["leaves_by_source"]["size field"].get<int>();
+  r = run_cli("size builtin:blocks --no-curvature --hmax 0.4 --size 3:1=0.05 --size region:2=0.05 --json " + dir +
+              "/both.json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  j = nlohmann::json::parse(cm::test::read_text(dir + "/both.json"));
+  // Twice the volume at size 0.05: about twice the interior leaves.
+  EXPECT_GT(j["octree"]["leaves_by_source"]["size field"].get<int>(), 1.8 * one_region);
+}
+
+TEST(CliSize, MissingRegionIsOneLineAndExitTwo) {
+  const std::string dir = cm::test::make_temp_dir("size");
+  const auto r = run_cli("size builtin:blocks --size region:3=0.1 -o " + dir + "/out.vtu");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(r.output,
+            "curvemesh: error: size on region 3: the model has no such entity (region tags are 1..2)\n");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out.vtu"));
+  EXPECT_NE(run_cli("size --help").output.find("region"), std::string::npos);
+}
+
 TEST(CliSize, BadOptionsGiveOneErrorAndExitTwo) {
   const std::string dir = cm::test::make_temp_dir("size");
   { std::ofstream(dir + "/short.sol") << "MeshVersionFormatted 2\nDimension 3\nSolAtVertices\n1\n1 1\n0.1\nEnd\n"; }
@@ -66,7 +96,9 @@ TEST(CliSize, BadOptionsGiveOneErrorAndExitTwo) {
     std::string args, expect;
   } cases[] = {
       {"builtin:box --size face:99=0.1", "no such entity"},
-      {"builtin:box --size region:1=0.1", "expected DIM:TAG=H"},
+      {"builtin:box --size cell:1=0.1", "expected DIM:TAG=H"},
+      {"builtin:box --size region:2=0.1", "size on region 2: the model has no such entity (region tags are 1..1)"},
+      {"builtin:box --size region:99999999999=0.1", "integer >= 1"},
       {"builtin:box --size face:1=-2", "finite and > 0"},
       {"builtin:box --size-expr 'sin(x'", "--size-expr"},
       {"builtin:box --size-expr '0-1'", "finite and > 0"},

@@ -632,6 +632,92 @@ TEST(Triangulation2dMesh, PrimitivesKeepInvariants) {
   EXPECT_EQ(m.check(), "");
 }
 
+// Bowyer–Watson with a caller's cavity: valid cavities become fans around the
+// new vertex; every invalid one is refused with the mesh untouched.
+TEST(Triangulation2dMesh, InsertInCavityChecksTheCavity) {
+  CdtInput in;
+  add_loop(in, square(0, 1, 4));  // points 0..15 on the boundary
+  in.points.push_back(Vec2(0.5, 0.5));  // 16
+  const Triangulation2d base = constrained_delaunay(in).mesh;
+  ASSERT_EQ(base.check(), "");
+  const auto live = [](const Triangulation2d& m) {
+    std::vector<int> ts;
+    for (int t = 0; t < int(m.tris.size()); ++t)
+      if (m.is_live(t)) ts.push_back(t);
+    return ts;
+  };
+  const auto expect_refused = [&](const Vec2& p, const std::vector<int>& cavity, const char* why) {
+    Triangulation2d m = base;
+    EXPECT_EQ(m.insert_in_cavity(p, cavity), -1) << why;
+    EXPECT_EQ(m.tris, base.tris) << why;
+    EXPECT_EQ(m.adj, base.adj) << why;
+    EXPECT_EQ(m.points.size(), base.points.size()) << why;
+  };
+
+  // The triangles whose circumcircle holds p: the Delaunay cavity, a fan
+  // with one triangle per boundary side, exact counts by Euler.
+  {
+    Triangulation2d m = base;
+    const Vec2 p(0.3, 0.6);
+    std::vector<int> cavity;
+    for (const int t : live(m)) {
+      const auto& v = m.tris[t];
+      if (predicates::incircle(m.points[v[0]].data(), m.points[v[1]].data(), m.points[v[2]].data(), p.data()) > 0)
+        cavity.push_back(t);
+    }
+    ASSERT_FALSE(cavity.empty());
+    std::vector<int> fan;
+    const int v = m.insert_in_cavity(p, cavity, &fan);
+    ASSERT_EQ(v, 17);
+    EXPECT_EQ(m.check(), "");
+    EXPECT_EQ(fan.size(), cavity.size() + 2);
+    for (const int f : fan) EXPECT_GE(m.local_index(f, v), 0);
+    EXPECT_EQ(int(m.num_tris()), euler_tris(used_vertices(m), 16, 0));
+    EXPECT_EQ(delaunay_violation(m), "");
+    EXPECT_NEAR(double(mesh_area(m)), 1.0, 1e-12);
+  }
+
+  std::vector<int> around_centre;
+  base.triangles_around(16, around_centre);
+  const int holder = locate(base, Vec2(0.3, 0.6));
+  ASSERT_GE(holder, 0);
+  // The whole ball of vertex 16: it would vanish.
+  expect_refused(Vec2(0.52, 0.51), around_centre, "cavity vertex inside the cavity");
+  // p outside the cavity: not star-shaped from p.
+  expect_refused(Vec2(0.05, 0.95), {holder}, "p outside the cavity");
+  expect_refused(Vec2(0.3, 0.6), {holder, holder}, "repeated triangle");
+  expect_refused(Vec2(0.3, 0.6), {}, "empty cavity");
+  // Two triangles that share no edge: the boundary is two cycles.
+  {
+    int far = -1;
+    for (const int t : live(base)) {
+      bool touches = t == holder;
+      for (const int v : base.tris[t])
+        if (base.local_index(holder, v) >= 0) touches = true;
+      if (!touches) far = t;
+    }
+    ASSERT_GE(far, 0);
+    expect_refused(Vec2(0.3, 0.6), {holder, far}, "disconnected cavity");
+  }
+  // A constrained edge between two cavity triangles would be lost: the same
+  // cavity that takes the point without the flag refuses it with the flag.
+  {
+    const Vec2 p = (base.points[base.tris[holder][0]] + base.points[base.tris[holder][1]] +
+                    base.points[base.tris[holder][2]]) / 3;
+    int n = 0;
+    while (base.adj[holder][n] < 0) ++n;
+    const std::vector<int> cavity{holder, base.adj[holder][n]};
+    Triangulation2d free_mesh = base;
+    EXPECT_EQ(free_mesh.insert_in_cavity(p, cavity), 17);
+    EXPECT_EQ(free_mesh.check(), "");
+    Triangulation2d m = base;
+    m.set_constrained(holder, n, true);
+    const auto tris = m.tris;
+    EXPECT_EQ(m.insert_in_cavity(p, cavity), -1);
+    EXPECT_EQ(m.tris, tris);
+  }
+}
+
 TEST(Triangulation2dPerf, MillionPointsThousandSegments) {
   const int n = 1000000, ns = 1000;
   CdtInput in;

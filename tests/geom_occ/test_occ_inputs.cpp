@@ -267,6 +267,34 @@ TEST(OccBuiltins, PartIsAFilletedBlockWithTwoHolesAndAFreeformTop) {
   EXPECT_NEAR(scaled->volume(1), part->volume(1) / 8, 1e-6 * part->volume(1));
 }
 
+TEST(OccBuiltins, BlocksAndInclusionAreConformalTwoRegionModels) {
+  const auto blocks = load_model("builtin:blocks:dx1=1,dx2=2");
+  ASSERT_EQ(blocks->count(3), 2);
+  EXPECT_EQ(blocks->count(2), 11);  // the face x = 1 once
+  std::multiset<double> volumes{blocks->volume(1), blocks->volume(2)};
+  EXPECT_NEAR(*volumes.begin(), 1, 1e-12);
+  EXPECT_NEAR(*volumes.rbegin(), 2, 1e-12);
+  int shared = 0;
+  for (int f = 1; f <= blocks->count(2); ++f) shared += blocks->upward({2, f}).size() == 2;
+  EXPECT_EQ(shared, 1);
+
+  const auto inclusion = load_model("builtin:inclusion:s=2,r=0.5");
+  ASSERT_EQ(inclusion->count(3), 2);
+  const double ball = 4.0 / 3 * M_PI * 0.125;
+  volumes = {inclusion->volume(1), inclusion->volume(2)};
+  EXPECT_NEAR(*volumes.begin(), ball, 1e-9);
+  EXPECT_NEAR(*volumes.rbegin(), 8 - ball, 1e-9);
+  // The sphere's face bounds both regions; the cube's six only the outer one.
+  int sphere_faces = 0;
+  for (int f = 1; f <= inclusion->count(2); ++f)
+    if (inclusion->type({2, f}) == geom::ShapeType::kSphere) {
+      ++sphere_faces;
+      EXPECT_EQ(inclusion->upward({2, f}), (std::vector<int>{1, 2}));
+    }
+  EXPECT_GE(sphere_faces, 1);
+  expect_error<InputError>("builtin:inclusion:s=1,r=0.5", "must fit inside");
+}
+
 TEST(OccBuiltins, QueriesOnMissingEntitiesThrow) {
   const auto box = load_model("builtin:box");
   EXPECT_THROW(box->type({2, 7}), std::out_of_range);
@@ -310,7 +338,7 @@ TEST(OccBuiltins, BadSpecificationsAreInputErrors) {
 
 TEST(OccBuiltins, HelpListsEveryBuiltinWithDefaults) {
   const std::string help = builtin_help();
-  for (const char* name : {"box", "sphere", "cylinder", "torus", "cone", "part"})
+  for (const char* name : {"box", "sphere", "cylinder", "torus", "cone", "part", "blocks", "inclusion"})
     EXPECT_NE(help.find(std::string("builtin:") + name), std::string::npos) << name;
   EXPECT_NE(help.find("R=2,r=0.5"), std::string::npos);
 }

@@ -5,6 +5,7 @@
 // Only what curvature sampling asks of a model is implemented.
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include <Eigen/Dense>
 
@@ -88,6 +89,9 @@ class BumpModel final : public geom::Model {
   }
   bool contains_param(int, const Vec2& uv) const override {
     return uv.x() >= 0 && uv.x() <= 1 && uv.y() >= 0 && uv.y() <= 1;
+  }
+  geom::Containment classify_point(int region, const Vec3&) const override {
+    throw std::out_of_range("BumpModel: an open plate has no region " + std::to_string(region));
   }
   double area(int) const override { return 1; }
   double length(int) const override { return 1; }

@@ -123,5 +123,36 @@ TEST(CurvatureSampling, EntitySizeCoversTheEntity) {
       for (const auto& s : samples) d = std::min(d, (s.point - x).norm());
       EXPECT_LE(d, 0.1 + 1e-9);
     }
-  EXPECT_THROW(sample_entity_size(*cyl, {3, 1}, 0.2), std::invalid_argument);
+  EXPECT_THROW(sample_entity_size(*cyl, {4, 1}, 0.2), std::invalid_argument);
+}
+
+TEST(CurvatureSampling, RegionSizeCoversEveryBoundingFaceOnce) {
+  const auto cyl = geom::make_analytic_cylinder(Vec3::Zero(), Vec3::UnitZ(), 1, 2);
+  const auto samples = sample_entity_size(*cyl, {3, 1}, 0.2);
+  // The boundary only (the interior is the size field's business), each
+  // sample on the face or edge it names.
+  for (const auto& s : samples) {
+    EXPECT_EQ(s.size, 0.2);
+    EXPECT_EQ(s.source, SizeSource::kEntitySize);
+    ASSERT_TRUE(s.entity.dim == 1 || s.entity.dim == 2);
+    EXPECT_LT(cyl->closest_point(s.entity, s.point).distance, 1e-9);
+  }
+  for (int face = 1; face <= 3; ++face) {
+    const auto pr = cyl->param_range({2, face});
+    for (int i = 0; i <= 20; ++i)
+      for (int j = 0; j <= 20; ++j) {
+        const Vec2 uv(pr.u0 + (pr.u1 - pr.u0) * i / 20, pr.v0 + (pr.v1 - pr.v0) * j / 20);
+        if (!cyl->contains_param(face, uv)) continue;
+        const Vec3 x = cyl->face_point(face, uv);
+        double d = 1e9;
+        for (const auto& s : samples) d = std::min(d, (s.point - x).norm());
+        EXPECT_LE(d, 0.1 + 1e-9) << "face " << face;
+      }
+  }
+  // Each face and edge sampled once: no two samples coincide except where
+  // a face's grid meets its own boundary or a closed edge meets itself.
+  std::size_t on_faces = 0;
+  for (int face = 1; face <= 3; ++face) on_faces += sample_entity_size(*cyl, {2, face}, 0.2).size();
+  EXPECT_LT(samples.size(), on_faces);
+  EXPECT_THROW(sample_entity_size(*cyl, {3, 2}, 0.2), std::out_of_range);
 }

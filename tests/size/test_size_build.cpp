@@ -3,9 +3,12 @@
 // background metric, and the octree invariants on real geometry.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "curvemesh/geom/analytic_model.hpp"
 #include "curvemesh/geom_occ/load.hpp"
@@ -209,4 +212,201 @@ TEST(SizeBuild, FreeformPartBuildsAndStaysGraded) {
   EXPECT_NEAR(r.hmax, part->bounding_box().diagonal() / 20, 1e-12);
   for (const auto& s : r.samples) ASSERT_LE(r.octree->size(s.point), s.size * (1 + 1e-9));
   expect_graded(*r.octree);
+}
+
+// --- sizes on regions ----------------------------------------------------------
+
+namespace {
+
+// Points of a unit-free sample: a deterministic cloud in a box.
+std::vector<Vec3> cloud(const Vec3& lo, const Vec3& hi, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3> out(static_cast<std::size_t>(n));
+  for (Vec3& p : out) p = lo + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(hi - lo);
+  return out;
+}
+
+SizeOptions region_options(int region, double h) {
+  SizeOptions o;
+  o.hmax = 0.5;
+  o.hmin = 1e-3;
+  o.hgrad = 1.3;
+  o.curvature = CurvatureRule::off();
+  o.entity_sizes = {{{3, region}, h}};
+  return o;
+}
+
+}  // namespace
+
+// Tolerances. Inside the region the octree's corners are at most H wherever
+// an octant lies inside the region or holds a boundary sample, so the
+// trilinear value is at most H there, exactly (1e-9 for rounding): that is
+// every point deeper than an octant's diagonal (octants there have side
+// <= 2H). An octant the boundary only clips (no corner, centre or sample
+// inside) interpolates towards its outside corners, which gradation keeps
+// within (hgrad − 1)·(its diagonal) of H, so up to 2 H in theory; the
+// boundary samples (spacing H/2) leave few such octants and little of the
+// region in them: measured at most 1.0002 H on these shapes. 1.35 H is
+// asserted, far below what a region the octree missed would show (hmax is
+// 6 H or more). Outside, gradation bounds growth by (hgrad − 1) per unit
+// length.
+TEST(SizeBuild, RegionSizeHoldsInsideAnalyticSphereAndGradesOutside) {
+  const double h = 0.08;
+  const auto sphere = geom::make_analytic_sphere(Vec3::Zero(), 1);
+  SizeOptions o = region_options(1, h);
+  o.curvature = CurvatureRule::relative_deviation(0.04);  // asks for more than h on this sphere
+  const SizeFieldResult r = build_size_field(*sphere, o);
+  double worst_deep = 0, worst = 0;
+  for (const Vec3& x : cloud(Vec3::Constant(-1), Vec3::Constant(1), 20000, 7)) {
+    if (x.norm() >= 1) continue;
+    const double s = r.field->size(x);
+    worst = std::max(worst, s / h);
+    // Deeper than one octant's diagonal (side <= 2h).
+    if (x.norm() < 1 - 2 * std::sqrt(3.0) * h) worst_deep = std::max(worst_deep, s / h);
+  }
+  EXPECT_LE(worst_deep, 1 + 1e-9);
+  EXPECT_LE(worst, 1.35);
+  // On the sphere, with its face as hint: h exactly, below the curvature size.
+  std::mt19937 rng(8);
+  std::normal_distribution<double> g;
+  for (int i = 0; i < 100; ++i) {
+    Vec3 x;
+    const SizeHint hint = on_face(*sphere, 1, Vec3(g(rng), g(rng), g(rng)).normalized(), &x);
+    EXPECT_DOUBLE_EQ(r.field->size(x, hint), h);
+    EXPECT_DOUBLE_EQ(r.field->size(x, SizeHint{{3, 1}, Vec2::Zero()}), h);
+  }
+  // Outside, towards the corners of the octree's cube (the model is the
+  // sphere, so that is as far as the field goes): graded by hgrad from h.
+  // The octants holding the boundary samples (side <= h) have all their
+  // corners at h, so h reaches up to one such octant beyond the surface
+  // before growth starts: the lower bound starts 2h out.
+  for (const double d : {0.1, 0.3, 0.5, 0.7}) {
+    for (const Vec3& corner : std::vector<Vec3>{Vec3(1, 1, 1), Vec3(-1, 1, -1), Vec3(1, -1, -1)}) {
+      const double s = r.field->size((1 + d) * corner.normalized());
+      EXPECT_LE(s, h + (o.hgrad - 1) * d * 1.05 + 1e-9) << "d " << d;
+      EXPECT_GE(s, h + 0.5 * (o.hgrad - 1) * std::max(0.0, d - 2 * h)) << "d " << d;
+    }
+  }
+  expect_graded(*r.octree);
+}
+
+TEST(SizeBuild, RegionSizeAppliesOnlyInTheNamedRegionOfTwoBlocks) {
+  const auto blocks = geom_occ::load_model("builtin:blocks");
+  ASSERT_EQ(blocks->count(3), 2);
+  const int left = blocks->center_of_mass(1).x() < 1 ? 1 : 2, right = 3 - left;
+  const double h = 0.05;
+  const SizeOptions o = region_options(left, h);
+  const SizeFieldResult r = build_size_field(*blocks, o);
+  double worst_deep = 0, worst = 0;
+  for (const Vec3& x : cloud(Vec3::Zero(), Vec3(1, 1, 1), 5000, 9)) {
+    const double s = r.field->size(x);
+    worst = std::max(worst, s / h);
+    const double depth = std::min({x.minCoeff(), (Vec3::Ones() - x).minCoeff()});
+    if (depth > 2 * std::sqrt(3.0) * h) worst_deep = std::max(worst_deep, s / h);
+  }
+  EXPECT_LE(worst_deep, 1 + 1e-9);
+  EXPECT_LE(worst, 1.35);
+  // The right block grades away from the interface x = 1 and reaches hmax.
+  for (const double d : {0.2, 0.5}) {
+    const double s = r.field->size(Vec3(1 + d, 0.5, 0.5));
+    EXPECT_GT(s, h + 0.5 * (o.hgrad - 1) * d);
+    EXPECT_LE(s, h + (o.hgrad - 1) * d * 1.05 + 1e-9);
+  }
+  // Hints: the interface bounds both regions, so it gets h; a face of the
+  // right block only does not.
+  int interface = 0, far_face = 0;
+  for (int f = 1; f <= blocks->count(2); ++f) {
+    const auto up = blocks->upward({2, f});
+    if (up.size() == 2) interface = f;
+    const geom::BoundingBox b = blocks->bounding_box({2, f});
+    if (up == std::vector<int>{right} && b.min.x() > 1.5) far_face = f;
+  }
+  ASSERT_GT(interface, 0);
+  ASSERT_GT(far_face, 0);
+  Vec3 x;
+  SizeHint hint = on_face(*blocks, interface, Vec3(1, 0.4, 0.6), &x);
+  EXPECT_DOUBLE_EQ(r.field->size(x, hint), h);
+  hint = on_face(*blocks, far_face, Vec3(2, 0.4, 0.6), &x);
+  EXPECT_GT(r.field->size(x, hint), 2 * h);
+  EXPECT_GT(r.field->size(x, SizeHint{{3, right}, Vec2::Zero()}), 2 * h);
+  // Edges and vertices of the left block's closure get h at a hint too,
+  // even where the octree has graded away (the far end of the model).
+  int closure_edges = 0;
+  for (int e = 1; e <= blocks->count(1); ++e) {
+    bool in_closure = false;
+    for (const int f : blocks->upward({1, e}))
+      for (const int reg : blocks->upward({2, f})) in_closure |= reg == left;
+    const geom::ParamRange pr = blocks->param_range({1, e});
+    const double u = 0.5 * (pr.u0 + pr.u1);
+    const double s = r.field->size(Vec3(2, 0.5, 0.5), SizeHint{{1, e}, Vec2(u, 0)});
+    if (in_closure) {
+      EXPECT_DOUBLE_EQ(s, h) << "edge " << e;
+      ++closure_edges;
+    } else {
+      EXPECT_GT(s, 2 * h) << "edge " << e;
+    }
+  }
+  EXPECT_EQ(closure_edges, 12);
+  for (int v = 1; v <= blocks->count(0); ++v) {
+    const bool left_vertex = blocks->vertex_point(v).x() < 1.5;
+    const double s = r.field->size(Vec3(2, 0.5, 0.5), SizeHint{{0, v}, Vec2::Zero()});
+    if (left_vertex) {
+      EXPECT_DOUBLE_EQ(s, h) << "vertex " << v;
+    } else {
+      EXPECT_GT(s, 2 * h) << "vertex " << v;
+    }
+  }
+  expect_graded(*r.octree);
+}
+
+// A slab thinner than h: octant corners rarely fall inside it, so what
+// holds h there is the sampling of its faces.
+TEST(SizeBuild, RegionThinnerThanItsSizeIsNotMissed) {
+  const auto blocks = geom_occ::load_model("builtin:blocks:dx1=0.013,dx2=1");
+  const int slab = blocks->volume(1) < blocks->volume(2) ? 1 : 2;
+  const double h = 0.1;
+  const SizeFieldResult r = build_size_field(*blocks, region_options(slab, h));
+  double worst = 0;
+  for (const Vec3& x : cloud(Vec3(0, 0, 0), Vec3(0.013, 1, 1), 3000, 10)) worst = std::max(worst, r.field->size(x) / h);
+  EXPECT_LE(worst, 1 + 1e-9);
+}
+
+TEST(SizeBuild, RegionSizeInsideAnInclusionAndOnItsBoundary) {
+  const auto inclusion = geom_occ::load_model("builtin:inclusion:s=2,r=0.5");
+  const int ball = inclusion->volume(1) < inclusion->volume(2) ? 1 : 2;
+  const double h = 0.04;
+  const SizeFieldResult r = build_size_field(*inclusion, region_options(ball, h));
+  double worst_deep = 0, worst = 0;
+  for (const Vec3& x : cloud(Vec3::Constant(-0.5), Vec3::Constant(0.5), 8000, 11)) {
+    if (x.norm() >= 0.5) continue;
+    const double s = r.field->size(x);
+    worst = std::max(worst, s / h);
+    if (x.norm() < 0.5 - 2 * std::sqrt(3.0) * h) worst_deep = std::max(worst_deep, s / h);
+  }
+  EXPECT_LE(worst_deep, 1 + 1e-9);
+  EXPECT_LE(worst, 1.35);
+  // The cube's faces are not in the ball's closure: graded from h over the
+  // 0.5 between the sphere and a face centre.
+  const double at_face = r.field->size(Vec3(1, 0, 0));
+  EXPECT_GT(at_face, h + 0.5 * 0.3 * 0.5);
+  EXPECT_LE(at_face, h + 0.3 * 0.5 * 1.05);
+}
+
+TEST(SizeBuild, RegionSizeOnAMissingRegionNamesIt) {
+  const auto blocks = geom_occ::load_model("builtin:blocks");
+  for (const int tag : {0, 3}) {
+    try {
+      build_size_field(*blocks, region_options(tag, 0.1));
+      ADD_FAILURE() << "region " << tag << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("size on region " + std::to_string(tag) + ": the model has no such entity"),
+                std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("region tags are 1..2"), std::string::npos) << e.what();
+    }
+  }
+  SizeOptions four = region_options(1, 0.1);
+  four.entity_sizes = {{{4, 1}, 0.1}};
+  EXPECT_THROW(build_size_field(*blocks, four), std::invalid_argument);
 }

@@ -48,13 +48,12 @@ ExactStats& exact_stats() {
 namespace {
 
 // ---------------------------------------------------------------------------
-// Filter constants.
-
-constexpr double kUnitRoundoff = 0x1p-53;
-
-// Error bound factor for an evaluation tree whose monomials each pass through at
-// most `roundings` rounded operations (a rounded difference used twice counts
-// twice), with the permanent computed by the same tree.
+// Filter constants (defined in predicates.hpp, shared with the inline filters).
+//
+// filter_constant(m) is the error bound factor for an evaluation tree whose
+// monomials each pass through at most m rounded operations (a rounded
+// difference used twice counts twice), with the permanent computed by the same
+// tree.
 //
 // Lemma. Write the exact determinant as D = sum_k s_k T_k, T_k products of exact
 // coordinate differences, s_k = +-1. Without underflow or overflow each
@@ -70,50 +69,50 @@ constexpr double kUnitRoundoff = 0x1p-53;
 // of 2^-152 and every value of a degree-k tree a multiple of 2^(-152 k), at
 // least 2^-760 when nonzero, far above the normal range limit 2^-1022.
 // The constant is exact in binary64 (m (1 + 2^-40) needs 46 bits).
-constexpr double filter_constant(int roundings) {
-  return roundings * kUnitRoundoff * (1.0 + 0x1p-40);
-}
+using detail::Bounded;
+using detail::certified_sign;
+using detail::filter_constant;
+using detail::kInsphereBound;
+using detail::kOrient3dBound;
+using detail::minor2;
 
-// Roundings per monomial, counted on the evaluation trees below.
 // orient2d: two differences, one product, one subtraction.
 constexpr double kOrient2dBound = filter_constant(4);
-// orient3d: three differences, the 2x2 product and subtraction, the product by
-// the third row, two additions.
-constexpr double kOrient3dBound = filter_constant(8);
 // incircle: lift (a difference twice, square, one addition) = 4; 2x2 minor
 // (two differences, product, subtraction) = 4; lift times minor 1; two additions.
 constexpr double kIncircleBound = filter_constant(11);
-// insphere: lift (a difference twice, square, two additions) = 5; 3x3 minor
-// (three differences, product, subtraction, product, two additions) = 8; lift
-// times minor 1; two additions.
-constexpr double kInsphereBound = filter_constant(16);
 
-// A value and the permanent of the same expression.
-struct Bounded {
-  double value;
-  double permanent;
-};
+// Small-integer stage. When every input coordinate is an integer of magnitude
+// at most 2^50 and the computed permanent P~ of orient3d or insphere is below
+// 2^50, the filter's floating-point value is the exact determinant, zero
+// included: grids and integer inputs, where ties are the rule, then never
+// reach the expansions.
+//
+// Lemma. The differences are integers of magnitude <= 2^51, computed exactly.
+// Every node N of the value tree then has an exact value that is an integer,
+// bounded by its permanent pi(N) (pi of a leaf is its magnitude, of a sum the
+// sum, of a product the product). Let w(N) be the product of the permanents of
+// the other factors met on the path from N to the root: pi(root) >= w(N) pi(N)
+// and w(N) is 0 or >= 1 (a product of nonnegative integers). By induction from
+// the leaves: (i) a node with pi(N) = 0 is computed as exactly 0 (a sum of
+// zeros, or a finite value times an exact 0: every computed value stays below
+// 2^(51 * 5) so none is infinite); (ii) a node with w(N) >= 1 is computed
+// exactly: its operands are exact (for a product A B with pi(B) = 0, B is 0 by
+// (i) and so is the computed product; otherwise w(A), w(B) >= w(N) >= 1), and
+// the exact result is an integer of magnitude <= pi(N) <= pi(root) < 2^51,
+// representable. The root has w = 1. Finally pi(root) <= P~ / (1 - gamma_16) <
+// 2^51 by the lemma above.
+constexpr double kIntegerPermanentLimit = 0x1p50;
 
-// p_x q_y - q_x p_y.
-inline Bounded minor2(double px, double py, double qx, double qy) {
-  const double left = px * qy;
-  const double right = qx * py;
-  return {left - right, std::abs(left) + std::abs(right)};
+inline bool small_integer(double x) {
+  return std::abs(x) <= 0x1p50 && x == static_cast<double>(static_cast<long long>(x));
 }
 
-// p_z M(q,r) - q_z M(p,r) + r_z M(p,q): a 3x3 determinant expanded along one
-// column. The evaluation order ((first - second) + third) is the one counted in
-// the filter constants.
-inline Bounded minor3(double pz, double qz, double rz, const Bounded& qr, const Bounded& pr,
-                      const Bounded& pq) {
-  return {pz * qr.value - qz * pr.value + rz * pq.value,
-          std::abs(pz) * qr.permanent + std::abs(qz) * pr.permanent + std::abs(rz) * pq.permanent};
+inline bool small_integers(const double* p) {
+  return small_integer(p[0]) && small_integer(p[1]) && small_integer(p[2]);
 }
 
-// +1 or -1 when |value| is certainly above the error bound, 0 when undecided.
-inline int certified_sign(double value, double bound) {
-  return static_cast<int>(value > bound) - static_cast<int>(value < -bound);
-}
+inline int sign_of(double x) { return static_cast<int>(x > 0.0) - static_cast<int>(x < 0.0); }
 
 [[maybe_unused]] inline bool all_finite(const double* p, int dim) {
   for (int i = 0; i < dim; ++i) {
@@ -526,14 +525,12 @@ int orient2d(const double* a, const double* b, const double* c) {
 
 int orient3d(const double* a, const double* b, const double* c, const double* d) {
   CM_DEBUG_ASSERT(all_finite(a, 3) && all_finite(b, 3) && all_finite(c, 3) && all_finite(d, 3));
-  const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
-  const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
-  const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
-  // det[u; v; w] expanded along its first row.
-  const Bounded det =
-      minor3(ux, uy, uz, minor2(vy, vz, wy, wz), minor2(vx, vz, wx, wz), minor2(vx, vy, wx, wy));
+  const Bounded det = detail::orient3d_det(a, b, c, d);
   if (const int s = certified_sign(det.value, kOrient3dBound * det.permanent)) return s;
   ++exact_stats().orient3d;
+  if (det.permanent < kIntegerPermanentLimit && small_integers(a) && small_integers(b) &&
+      small_integers(c) && small_integers(d))
+    return sign_of(det.value);
   return orient3d_exact(a, b, c, d);
 }
 
@@ -559,34 +556,33 @@ int incircle(const double* a, const double* b, const double* c, const double* d)
 int insphere(const double* a, const double* b, const double* c, const double* d, const double* e) {
   CM_DEBUG_ASSERT(all_finite(a, 3) && all_finite(b, 3) && all_finite(c, 3) && all_finite(d, 3) &&
                   all_finite(e, 3));
-  const double aex = a[0] - e[0], aey = a[1] - e[1], aez = a[2] - e[2];
-  const double bex = b[0] - e[0], bey = b[1] - e[1], bez = b[2] - e[2];
-  const double cex = c[0] - e[0], cey = c[1] - e[1], cez = c[2] - e[2];
-  const double dex = d[0] - e[0], dey = d[1] - e[1], dez = d[2] - e[2];
-  const double a_lift = aex * aex + aey * aey + aez * aez;
-  const double b_lift = bex * bex + bey * bey + bez * bez;
-  const double c_lift = cex * cex + cey * cey + cez * cez;
-  const double d_lift = dex * dex + dey * dey + dez * dez;
-  // 2x2 minors of the (x, y) columns, then 3x3 minors along the z column.
-  const Bounded ab = minor2(aex, aey, bex, bey);
-  const Bounded ac = minor2(aex, aey, cex, cey);
-  const Bounded ad = minor2(aex, aey, dex, dey);
-  const Bounded bc = minor2(bex, bey, cex, cey);
-  const Bounded bd = minor2(bex, bey, dex, dey);
-  const Bounded cd = minor2(cex, cey, dex, dey);
-  const Bounded bcd = minor3(bez, cez, dez, cd, bd, bc);
-  const Bounded acd = minor3(aez, cez, dez, cd, ad, ac);
-  const Bounded abd = minor3(aez, bez, dez, bd, ad, ab);
-  const Bounded abc = minor3(aez, bez, cez, bc, ac, ab);
-  // Minus det[[p - e, |p - e|^2]] expanded along the lifted column.
-  const double det =
-      (a_lift * bcd.value - b_lift * acd.value) + (c_lift * abd.value - d_lift * abc.value);
-  const double permanent = (a_lift * bcd.permanent + b_lift * acd.permanent) +
-                           (c_lift * abd.permanent + d_lift * abc.permanent);
-  if (const int s = certified_sign(det, kInsphereBound * permanent)) return s;
+  const Bounded det = detail::insphere_det(a, b, c, d, e);
+  if (const int s = certified_sign(det.value, kInsphereBound * det.permanent)) return s;
   ++exact_stats().insphere;
+  if (det.permanent < kIntegerPermanentLimit && small_integers(a) && small_integers(b) &&
+      small_integers(c) && small_integers(d) && small_integers(e))
+    return sign_of(det.value);
   return insphere_exact(a, b, c, d, e);
 }
+
+namespace detail {
+
+int insphere_after_static(const double* a, const double* b, const double* c, const double* d,
+                          const double* e, StaticValue v) {
+  // The small-integer lemma above, with the permanent bounded through the
+  // static scale: pi(root) <= 24 L* X* Y* Z* <= 24 scale / (1 - u)^6 (exact
+  // differences here; a computed lift is at least (1 - u)^3 times the exact
+  // one, the scale's evaluation loses (1 - u)^3), so fl(24 scale) < 2^50
+  // gives pi(root) < 2^51. v.value is the same tree's value, hence exact.
+  if (24.0 * v.scale < kIntegerPermanentLimit && small_integers(a) && small_integers(b) &&
+      small_integers(c) && small_integers(d) && small_integers(e)) {
+    ++exact_stats().insphere;
+    return sign_of(v.value);
+  }
+  return insphere(a, b, c, d, e);
+}
+
+}  // namespace detail
 
 double orient3d_fast(const double* a, const double* b, const double* c, const double* d) {
   const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];

@@ -21,13 +21,33 @@ VertId add_vertex(mesh::TetMesh& m, const Vec3& x, mesh::ModelRef on, mesh::Para
   return static_cast<VertId>(m.coords.size() - 1);
 }
 
-// Points along a degenerate (pole) edge in a face's (u, v): as many as a
-// ring of triangles around the pole needs, about six per full turn.
-int pole_points(const geom::Model& model, int face) {
-  const geom::ParamRange r = model.param_range({2, face});
-  if (r.periodic_u && r.period_u > 0) return std::clamp(int(std::lround(6 * (r.u1 - r.u0) / r.period_u)), 2, 64);
-  if (r.periodic_v && r.period_v > 0) return std::clamp(int(std::lround(6 * (r.v1 - r.v0) / r.period_v)), 2, 64);
-  return 4;
+// Segments along a degenerate (pole) edge in a face's (u, v). The pole
+// triangles they bound vanish from the surface mesh, but each segment is a
+// front edge that gets its own point at about the size from the pole, and
+// those points make the ring of vertices around the pole together with the
+// first node of the edges on either side (one node when that is a seam).
+// A ring should split the angle θ the face turns around the pole into
+// about 60° pieces: round(θ / 60°) + 1 nodes if the fan is open, two of
+// them from the edges, round(θ / 60°) if it closes over a seam, one from
+// it; either way round(θ / 60°) - 1 segments (at least one). θ is summed
+// from the direction leaving the pole (the derivative across the
+// degenerate side) at samples along it.
+int pole_segments(const geom::Model& model, int face, const geom::OrientedUse& use, const EdgeMesh& em) {
+  constexpr int kSamples = 24;
+  double turned = 0;
+  Vec3 previous = Vec3::Zero();
+  for (int k = 0; k <= kSamples; ++k) {
+    // Half a step in from the ends, where the side meets other edges.
+    const double s = std::clamp(double(k), 0.5, kSamples - 0.5) / kSamples;
+    const double t = em.params.front() + s * (em.params.back() - em.params.front());
+    const Vec2 uv = model.edge_param_on_face(use.tag, face, t, use.forward);
+    const geom::SurfaceDerivatives d = model.face_derivatives(face, uv);
+    const Vec3 across = (d.du.squaredNorm() > d.dv.squaredNorm() ? d.du : d.dv).normalized();
+    if (!across.allFinite()) continue;
+    if (previous != Vec3::Zero()) turned += std::acos(std::clamp(previous.dot(across), -1.0, 1.0));
+    previous = across;
+  }
+  return std::clamp(int(std::lround(turned / (std::numbers::pi / 3))) - 1, 1, 64);
 }
 
 std::vector<std::vector<BoundaryPoint>> face_loops(const geom::Model& model, int face,
@@ -41,7 +61,7 @@ std::vector<std::vector<BoundaryPoint>> face_loops(const geom::Model& model, int
       const EdgeMesh& em = edges[use.tag - 1];
       const std::vector<VertId>& ids = nodes[use.tag];
       if (em.degenerate) {
-        const int n = pole_points(model, face);
+        const int n = pole_segments(model, face, use, em);
         for (int k = 0; k < n; ++k) {
           const double t = double(k) / n;
           const double u = use.forward ? em.params.front() + t * (em.params.back() - em.params.front())

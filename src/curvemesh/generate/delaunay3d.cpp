@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "curvemesh/core/error.hpp"
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/generate/spatial_sort.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
@@ -10,17 +11,23 @@
 
 namespace cm::generate {
 
-int insphere_perturbed(const mesh::TetMesh& m, const std::array<VertId, 4>& t, VertId e) {
-  const double* p[5] = {m.coords[t[0]].data(), m.coords[t[1]].data(), m.coords[t[2]].data(),
-                        m.coords[t[3]].data(), m.coords[e].data()};
-  const int s = predicates::insphere(p[0], p[1], p[2], p[3], p[4]);
-  if (s != 0) return s;
-  // Lift point i by ε^(rank): the derivative of insphere with respect to the
-  // lift of tet vertex k is the sign of the barycentric coordinate of e in
-  // the tet (e put in place of vertex k); for e itself it is -1 (lifting e
-  // moves it outside). The most perturbed point whose term is nonzero wins.
-  std::array<std::pair<VertId, int>, 5> order{{{t[0], 0}, {t[1], 1}, {t[2], 2}, {t[3], 3}, {e, 4}}};
-  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+namespace {
+
+// The tie-break of insphere_perturbed, after an exact insphere returned 0
+// (out of line: the cavity loop keeps only the inline filter).
+// Lift point i by ε^(rank): the derivative of insphere with respect to the
+// lift of tet vertex k is the sign of the barycentric coordinate of e in the
+// tet (e put in place of vertex k); for e itself it is -1 (lifting e moves it
+// outside). The most perturbed point whose term is nonzero wins. The rank is
+// the vertex id, through `rank` when the mesh is temporarily renumbered
+// (Delaunay3d::insert_all).
+[[gnu::noinline]] int perturbed_tie(const double* const p[5], const std::array<VertId, 4>& t,
+                                    VertId e, const VertId* rank) {
+  auto r = [rank](VertId v) { return rank ? rank[v] : v; };
+  std::array<std::pair<VertId, int>, 5> order{
+      {{r(t[0]), 0}, {r(t[1]), 1}, {r(t[2]), 2}, {r(t[3]), 3}, {r(e), 4}}};
+  std::sort(order.begin(), order.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [id, slot] : order) {
     if (slot == 4) return -1;
     const double* q[4] = {p[0], p[1], p[2], p[3]};
@@ -29,6 +36,20 @@ int insphere_perturbed(const mesh::TetMesh& m, const std::array<VertId, 4>& t, V
     if (o != 0) return o;
   }
   return -1;  // unreachable for a positive tet
+}
+
+inline int insphere_perturbed_fast(const mesh::TetMesh& m, const std::array<VertId, 4>& t, VertId e,
+                                   const VertId* rank) {
+  const double* p[5] = {m.coords[t[0]].data(), m.coords[t[1]].data(), m.coords[t[2]].data(),
+                        m.coords[t[3]].data(), m.coords[e].data()};
+  const int s = predicates::insphere_inline(p[0], p[1], p[2], p[3], p[4]);
+  return s != 0 ? s : perturbed_tie(p, t, e, rank);
+}
+
+}  // namespace
+
+int insphere_perturbed(const mesh::TetMesh& m, const std::array<VertId, 4>& t, VertId e) {
+  return insphere_perturbed_fast(m, t, e, nullptr);
 }
 
 Delaunay3d::Delaunay3d(mesh::TetMesh& m, const Vec3& lo, const Vec3& hi) : editor_(m) {
@@ -56,9 +77,11 @@ TetId Delaunay3d::locate(const Vec3& x, TetId hint) {
     for (t = 0; editor_.is_dead(t); ++t) {
     }
   }
+  const double* xp = x.data();
   int from = -1;  // the face we entered through: x is known to be behind it
   for (std::size_t steps = 0;; ++steps) {
     const auto& tv = m.tet2verts[t];
+    // The face order varies so the walk cannot cycle; xorshift, 2 bits a step.
     rng_ ^= rng_ << 13;
     rng_ ^= rng_ >> 7;
     rng_ ^= rng_ << 17;
@@ -68,8 +91,10 @@ TetId Delaunay3d::locate(const Vec3& x, TetId hint) {
       const int f = (start + k) & 3;
       if (f == from) continue;
       const auto& fv = mesh::kFaceVerts[f];
-      if (predicates::orient3d(m.coords[tv[fv[0]]].data(), m.coords[tv[fv[1]]].data(), m.coords[tv[fv[2]]].data(),
-                               x.data()) > 0) {
+      const double* a = m.coords[tv[fv[0]]].data();
+      const double* b = m.coords[tv[fv[1]]].data();
+      const double* c = m.coords[tv[fv[2]]].data();
+      if (predicates::orient3d_inline(a, b, c, xp) > 0) {
         exit = f;
         break;
       }
@@ -120,35 +145,32 @@ Delaunay3d::Result Delaunay3d::insert(VertId v, TetId hint) {
   for (VertId w : m.tet2verts[t0])
     if (m.coords[w] == x) {
       res.refusal = modify::Refusal::kDuplicatePoint;
-      res.duplicate_of = w;
+      res.duplicate_of = rank_ ? rank_[w] : w;
       return res;
     }
-  cavity_.reset(editor_);
-  cavity_.add(editor_, t0);
-  stack_.assign(1, t0);
+  // The cavity: t0 (x is in it, so strictly inside its circumsphere unless x
+  // is a vertex, refused above) and every tet reached from it whose
+  // circumsphere holds x, each neighbour tested once.
   const bool constrained = protected_count_ != 0;
-  while (!stack_.empty()) {
-    const TetId t = stack_.back();
-    stack_.pop_back();
-    for (int f = 0; f < 4; ++f) {
-      const Index across = m.tet2adj[4 * t + f];
-      if (across == kNone) continue;
-      const TetId n = mesh::face_tet(across);
-      if (cavity_.contains(editor_, n)) continue;
-      if (constrained && editor_.face_marked(mesh::pack_face(t, f))) continue;
-      if (insphere_perturbed(m, m.tet2verts[n], v) > 0) {
-        cavity_.add(editor_, n);
-        stack_.push_back(n);
-      }
-    }
-  }
-  cavity_.compute_boundary(editor_);
+  cavity_.reset(editor_);
+  auto in_conflict = [&](TetId n) {
+    return insphere_perturbed_fast(m, m.tet2verts[n], v, rank_) > 0;
+  };
+  const bool kept = cavity_.grow(editor_, t0, in_conflict, constrained);
   res.cavity_size = cavity_.tets().size();
-  if (const auto r = modify::check_star(m, cavity_, v); r != modify::Refusal::kNone) {
-    // Unconstrained cavities are star-shaped by construction (see header).
-    if (!constrained) throw std::logic_error("Delaunay3d: unconstrained cavity not star-shaped");
-    res.refusal = r;
+  if (!kept) {
+    res.refusal = modify::Refusal::kConstrainedFace;
     return res;
+  }
+  if (constrained) {
+    if (const auto r = modify::check_star(m, cavity_, v); r != modify::Refusal::kNone) {
+      res.refusal = r;
+      return res;
+    }
+  } else {
+    // Unconstrained cavities are star-shaped by construction (see header);
+    // checking costs one orient3d per boundary face, so debug builds only.
+    CM_DEBUG_ASSERT(modify::check_star(m, cavity_, v) == modify::Refusal::kNone);
   }
   const auto created = modify::fill_star(editor_, cavity_, v);
   last_ = created.front();
@@ -156,13 +178,87 @@ Delaunay3d::Result Delaunay3d::insert(VertId v, TetId hint) {
 }
 
 std::vector<VertId> Delaunay3d::insert_all(std::span<const VertId> verts) {
-  const auto& m = editor_.mesh();
-  std::vector<Vec3> pts(verts.size());
-  for (std::size_t i = 0; i < verts.size(); ++i) pts[i] = m.coords[verts[i]];
+  auto& m = editor_.mesh();
+  std::vector<std::uint32_t> order;
+  {
+    std::vector<Vec3> pts(verts.size());
+    for (std::size_t i = 0; i < verts.size(); ++i) pts[i] = m.coords[verts[i]];
+    order = brio_order(pts);
+  }
+  // A Delaunay tetrahedralization of n points in general position has about
+  // 6.7 n tets (fewer for grids and surfaces): reserving that much up front
+  // spares the copies of repeated growth; untouched capacity costs no memory.
+  editor_.reserve(editor_.live_tets() + 7 * verts.size() + 64);
+  if (m.vert2tet.size() < m.coords.size()) m.vert2tet.resize(m.coords.size(), kNone);
+  // Insertion never reads vert2tet: rebuild it once at the end rather than
+  // rewriting scattered seeds for every new tet (restored even on a throw).
+  struct SeedsRestored {
+    modify::MeshEditor& ed;
+    bool was;
+    ~SeedsRestored() { ed.defer_seeds(was); }
+  } seeds{editor_, editor_.seeds_deferred()};
+  editor_.defer_seeds(true);
+
+  // Vertex ids follow the input, which is in no spatial order: every
+  // coordinate read would be a cache (and TLB) miss. Unless a rebuild hook
+  // watches, the mesh is renumbered for the duration so that vertices come in
+  // insertion order (a copy of the coordinates, tets relabelled), and back at
+  // the end (even on a throw). Ties are still broken by the original ids
+  // (rank_), so the result is exactly that of inserting in place.
+  std::vector<VertId> new2old;
+  std::vector<Vec3> saved_coords;
+  struct Renumbered {
+    Delaunay3d& dt;
+    std::vector<VertId>& new2old;
+    std::vector<Vec3>& saved_coords;
+    ~Renumbered() {
+      if (new2old.empty()) return;
+      auto& mm = dt.editor_.mesh();
+      mm.coords.swap(saved_coords);
+      for (TetId t = 0; t < mm.tet2verts.size(); ++t)
+        if (!dt.editor_.is_dead(t))
+          for (VertId& v : mm.tet2verts[t]) v = new2old[v];
+      dt.rank_ = nullptr;
+    }
+  } renumbered{*this, new2old, saved_coords};
+  // The vertex to insert k-th, in the numbering in force.
+  std::vector<VertId> sequence(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) sequence[k] = verts[order[k]];
+  if (!editor_.hook() && rank_ == nullptr) {
+    const std::size_t nv = m.coords.size();
+    std::vector<VertId> old2new(nv, kNone);
+    new2old.reserve(nv);
+    // (A short loop of independent scattered accesses: their misses overlap,
+    // where one per insertion would stall it.)
+    for (VertId& v : sequence) {
+      if (old2new[v] == kNone) {
+        old2new[v] = static_cast<VertId>(new2old.size());
+        new2old.push_back(v);
+      }
+      v = old2new[v];
+    }
+    for (VertId v = 0; v < nv; ++v)
+      if (old2new[v] == kNone) {
+        old2new[v] = static_cast<VertId>(new2old.size());
+        new2old.push_back(v);
+      }
+    std::vector<Vec3> local(nv);
+    for (VertId l = 0; l < nv; ++l) local[l] = m.coords[new2old[l]];
+    saved_coords.swap(m.coords);
+    m.coords.swap(local);
+    for (TetId t = 0; t < m.tet2verts.size(); ++t)
+      if (!editor_.is_dead(t))
+        for (VertId& v : m.tet2verts[t]) v = old2new[v];
+    rank_ = new2old.data();
+  }
+
   std::vector<VertId> dup(verts.size(), kNone);
-  for (std::uint32_t i : brio_order(pts)) {
-    const Result r = insert(verts[i]);
-    if (r.refusal == modify::Refusal::kDuplicatePoint) dup[i] = r.duplicate_of;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    // Without renumbering the next point's coordinates are a sure cache miss
+    // unless loaded ahead.
+    if (rank_ == nullptr && k + 1 < order.size()) __builtin_prefetch(&m.coords[sequence[k + 1]]);
+    const Result r = insert(sequence[k]);
+    if (r.refusal == modify::Refusal::kDuplicatePoint) dup[order[k]] = r.duplicate_of;
   }
   return dup;
 }

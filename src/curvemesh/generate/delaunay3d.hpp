@@ -14,7 +14,9 @@
 //   degeneracy (grids, cospherical or coplanar sets).
 // - Constrained insertion: faces registered with protect() are never crossed
 //   by a cavity (interior points never cut a recovered boundary face); such a
-//   cavity may not be star-shaped, and the point is then refused.
+//   cavity may not be star-shaped, and the point is then refused
+//   (kNotStarShaped), as it is when the cavity reaches around a protected
+//   face and would delete it (kConstrainedFace).
 // - Duplicate points are refused and reported with the vertex they repeat.
 #include <array>
 #include <span>
@@ -53,7 +55,8 @@ class Delaunay3d {
   /// Inserts vertex v (already in the mesh's coords, in no tet).
   Result insert(VertId v, TetId hint = kNone);
   /// Inserts many vertices in BRIO + Hilbert order; returns, per input
-  /// position, the vertex it duplicates or kNone.
+  /// position, the vertex it duplicates or kNone. vert2tet is rebuilt at the
+  /// end (MeshEditor::defer_seeds): a rebuild hook must not read it meanwhile.
   std::vector<VertId> insert_all(std::span<const VertId> verts);
 
   /// Marks a face of the mesh (vertex triple, any order) that cavities must
@@ -76,9 +79,11 @@ class Delaunay3d {
   std::array<VertId, 4> far_{};
   TetId last_ = 0;
   std::uint64_t rng_ = 0x9E3779B97F4A7C15ull;
+  // While insert_all renumbers the mesh: original id of each vertex (the
+  // rank of the symbolic perturbation), else null.
+  const VertId* rank_ = nullptr;
   std::size_t walk_steps_ = 0;
   std::size_t protected_count_ = 0;
-  std::vector<TetId> stack_;
   mutable std::vector<TetId> ball_;
 };
 

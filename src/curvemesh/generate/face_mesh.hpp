@@ -6,17 +6,26 @@
 // 1. The boundary loops (discretized model edges through their p-curves)
 //    are triangulated by a constrained Delaunay triangulation with exact
 //    predicates, in (u, v) scaled per face by the mean first fundamental
-//    form so that the plane is close to isometric to the surface.
-// 2. Refinement by Delaunay point insertion: a triangle whose longest edge,
-//    measured in 3D against the size field, exceeds √2 gets a point at its
-//    circumcentre (centroid when that falls outside or next to an existing
-//    point); the cavity never crosses the boundary.
-// 3. Optimization with local operators judged on the 3D triangles: edge
-//    flips and smoothing in (u, v), each accepted only if every triangle
-//    keeps a positive (u, v) orientation (no parametric overlap) and the
-//    worst 3D quality improves.
-// Distorted parametrizations (poles, stretched B-splines) are handled by
-// judging every decision on the 3D triangle rather than in (u, v).
+//    form, then flipped towards the Delaunay triangulation of the surface's
+//    own metric (the first fundamental form), which matters where (u, v) is
+//    far from isometric: at poles and in narrow wedges.
+// 2. Frontal-Delaunay refinement (Rebay; Gmsh's default surface algorithm):
+//    the largest triangle on the front (the boundary, or triangles whose 3D
+//    circumradius is already under 1/√2 sizes) gets a point facing its front
+//    edge at the height of an equilateral triangle of the local size,
+//    measured in the first fundamental form; the point goes in by a
+//    Bowyer–Watson cavity grown with that metric's in-circle test and checked
+//    exactly, never across the boundary. What the front leaves (narrow
+//    places) gets circumcentres until no edge is over √2 sizes.
+// 3. Optimization judged on the 3D triangles: edge flips for the worst
+//    quality, and smoothing of each vertex towards the equilateral apexes of
+//    its ball's edges (built in 3D, taken back through the tangent map),
+//    kept when the ball's worst triangle does not get worse and its sum
+//    grows. Every accepted change keeps all triangles positive in (u, v) (no
+//    parametric overlap) and their normals along the surface's; triangles
+//    that fold at their centroid are flipped or split at the end.
+// Points of a pole (several (u, v) points, one vertex) bound triangles that
+// vanish from the surface mesh; they count as neither good nor bad.
 #include <vector>
 
 #include "curvemesh/geom/model.hpp"

@@ -6,31 +6,42 @@
 
 namespace cm::generate {
 
+namespace {
+
+// Spreads the low 21 bits of x so that bit b lands on bit 3b.
+std::uint64_t spread3(std::uint64_t x) {
+  x &= 0x1FFFFFu;
+  x = (x | x << 32) & 0x001F00000000FFFFull;
+  x = (x | x << 16) & 0x001F0000FF0000FFull;
+  x = (x | x << 8) & 0x100F00F00F00F00Full;
+  x = (x | x << 4) & 0x10C30C30C30C30C3ull;
+  x = (x | x << 2) & 0x1249249249249249ull;
+  return x;
+}
+
+}  // namespace
+
 std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z, int bits) {
-  // Skilling, "Programming the Hilbert curve" (2004): axes -> transposed index.
+  // Skilling, "Programming the Hilbert curve" (2004): axes -> transposed
+  // index. Written without data-dependent branches (they mispredict half the
+  // time on random points): `set` is all ones when bit Q of X[i] is.
   std::uint32_t X[3] = {x, y, z};
-  const std::uint32_t M = 1u << (bits - 1);
-  for (std::uint32_t Q = M; Q > 1; Q >>= 1) {
-    const std::uint32_t P = Q - 1;
+  for (int q = bits - 1; q > 0; --q) {
+    const std::uint32_t P = (1u << q) - 1;
     for (int i = 0; i < 3; ++i) {
-      if (X[i] & Q) {
-        X[0] ^= P;
-      } else {
-        const std::uint32_t t = (X[0] ^ X[i]) & P;
-        X[0] ^= t;
-        X[i] ^= t;
-      }
+      const std::uint32_t set = 0u - ((X[i] >> q) & 1u);
+      // Bit set: invert the low bits of X[0]; clear: exchange them with X[i]'s.
+      const std::uint32_t t = (X[0] ^ X[i]) & P & ~set;
+      X[0] ^= t ^ (P & set);
+      X[i] ^= t;
     }
   }
   for (int i = 1; i < 3; ++i) X[i] ^= X[i - 1];
   std::uint32_t t = 0;
-  for (std::uint32_t Q = M; Q > 1; Q >>= 1)
-    if (X[2] & Q) t ^= Q - 1;
+  for (int q = bits - 1; q > 0; --q) t ^= ((1u << q) - 1) & (0u - ((X[2] >> q) & 1u));
   for (auto& c : X) c ^= t;
-  std::uint64_t key = 0;
-  for (int b = bits - 1; b >= 0; --b)
-    for (int i = 0; i < 3; ++i) key = (key << 1) | ((X[i] >> b) & 1u);
-  return key;
+  // Interleave, most significant bit first: X[0]'s bit b goes to 3b + 2.
+  return spread3(X[0]) << 2 | spread3(X[1]) << 1 | spread3(X[2]);
 }
 
 std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_t seed) {
@@ -46,14 +57,20 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
   constexpr int kBits = 20;
   const double ext = std::max((hi - lo).maxCoeff(), 1e-300);
   const double scale = ((1u << kBits) - 1) / ext;
-  std::vector<std::uint64_t> keys(n);
+  // Keys travel with their index, so sorting reads contiguous memory.
+  struct Keyed {
+    std::uint64_t key;
+    std::uint32_t index;
+  };
+  std::vector<Keyed> items(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 q = (points[i] - lo) * scale;
-    keys[i] = hilbert_key(static_cast<std::uint32_t>(q.x()), static_cast<std::uint32_t>(q.y()),
-                          static_cast<std::uint32_t>(q.z()), kBits);
+    items[i] = {hilbert_key(static_cast<std::uint32_t>(q.x()), static_cast<std::uint32_t>(q.y()),
+                            static_cast<std::uint32_t>(q.z()), kBits),
+                static_cast<std::uint32_t>(i)};
   }
   std::mt19937_64 rng(seed);
-  std::shuffle(order.begin(), order.end(), rng);
+  std::shuffle(items.begin(), items.end(), rng);
   // Rounds of growing size: ..., n/8, n/4, n/2 (the first one at least 1000).
   std::vector<std::size_t> ends;
   for (std::size_t end = n; end > 0;) {
@@ -63,10 +80,11 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
   }
   std::size_t begin = 0;
   for (auto it = ends.rbegin(); it != ends.rend(); ++it) {
-    std::sort(order.begin() + static_cast<std::ptrdiff_t>(begin), order.begin() + static_cast<std::ptrdiff_t>(*it),
-              [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b] || (keys[a] == keys[b] && a < b); });
+    std::sort(items.begin() + static_cast<std::ptrdiff_t>(begin), items.begin() + static_cast<std::ptrdiff_t>(*it),
+              [](const Keyed& a, const Keyed& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); });
     begin = *it;
   }
+  for (std::size_t i = 0; i < n; ++i) order[i] = items[i].index;
   return order;
 }
 

@@ -221,6 +221,67 @@ std::array<int, 4> Triangulation2d::split_edge(int t, int i, int v) {
   return {t, t1, u, u1};
 }
 
+int Triangulation2d::insert_in_cavity(const Vec2& p, const std::vector<int>& cavity, std::vector<int>* fan) {
+  if (cavity.empty() || !p.allFinite()) return -1;
+  std::vector<int> sorted = cavity;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return -1;
+  for (const int t : sorted)
+    if (t < 0 || std::size_t(t) >= tris.size() || !is_live(t)) return -1;
+  const auto in_cavity = [&](int t) { return t >= 0 && std::binary_search(sorted.begin(), sorted.end(), t); };
+  struct Side {
+    int a, b, outer;
+    bool constrained;
+  };
+  std::vector<Side> sides;
+  for (const int t : cavity)
+    for (int i = 0; i < 3; ++i) {
+      const int n = adj[t][i];
+      if (in_cavity(n)) {
+        if (is_constrained(t, i)) return -1;
+        continue;
+      }
+      const auto [a, b] = edge(t, i);
+      if (predicates::orient2d(points[a].data(), points[b].data(), p.data()) <= 0) return -1;
+      sides.push_back({a, b, n, is_constrained(t, i)});
+    }
+  // One cycle through distinct vertices: each vertex starts exactly one side,
+  // and following the sides from the first one visits them all.
+  std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) { return x.a < y.a; });
+  for (std::size_t k = 0; k + 1 < sides.size(); ++k)
+    if (sides[k].a == sides[k + 1].a) return -1;
+  const auto side_from = [&](int a) {
+    const auto it = std::lower_bound(sides.begin(), sides.end(), a, [](const Side& s, int x) { return s.a < x; });
+    return it != sides.end() && it->a == a ? int(it - sides.begin()) : -1;
+  };
+  std::size_t walked = 0;
+  for (int k = 0;;) {
+    ++walked;
+    k = side_from(sides[k].b);
+    if (k < 0) return -1;
+    if (k == 0) break;
+    if (walked > sides.size()) return -1;
+  }
+  if (walked != sides.size()) return -1;
+  // A simple cycle, all of whose edges p sees from the left, winds once
+  // around p, so it bounds the cavity; a vertex inside it would be lost.
+  for (const int t : cavity)
+    for (const int v : tris[t])
+      if (side_from(v) < 0) return -1;
+
+  for (const int t : cavity) remove_triangle(t);
+  const int v = add_point(p);
+  std::vector<int> made(sides.size());
+  for (std::size_t k = 0; k < sides.size(); ++k) {
+    made[k] = add_triangle(sides[k].a, sides[k].b, v);
+    set_neighbour(made[k], 2, sides[k].outer, sides[k].constrained);
+  }
+  // Fan triangle (a, b, v): its edge 0 (b, v) is edge 1 of the triangle starting at b.
+  for (std::size_t k = 0; k < sides.size(); ++k) set_neighbour(made[k], 0, made[side_from(sides[k].b)], false);
+  if (fan) *fan = std::move(made);
+  return v;
+}
+
 void Triangulation2d::compact() {
   std::vector<int> remap(tris.size(), -1);
   int k = 0;

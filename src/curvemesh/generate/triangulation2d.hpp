@@ -105,6 +105,20 @@ struct Triangulation2d {
   /// halves keep the edge's constraint flag, so splitting a constrained edge
   /// yields two constrained edges.
   std::array<int, 4> split_edge(int t, int i, int v);
+  /// Bowyer–Watson step with a cavity chosen by the caller (e.g. by an
+  /// anisotropic in-circle test that the exact kernel does not offer):
+  /// replaces the live triangles `cavity` by the fan joining a new vertex at
+  /// p to the cavity's boundary, keeping the boundary edges' neighbours and
+  /// constraint flags. Checked exactly first, leaving the mesh unchanged and
+  /// returning -1 when the fan would not be a valid triangulation of the
+  /// cavity: a repeated or dead triangle, a constrained edge between two
+  /// cavity triangles, a boundary that is not one cycle through distinct
+  /// vertices, a cavity vertex not on that boundary, or p not strictly on
+  /// the left of every boundary edge (exact orient2d > 0; together these make
+  /// the cavity a disk that is star-shaped from p). Returns the new vertex
+  /// index; `fan`, if given, receives the new triangles. O(k log k) for k
+  /// cavity triangles.
+  int insert_in_cavity(const Vec2& p, const std::vector<int>& cavity, std::vector<int>* fan = nullptr);
 
   /// Drops deleted slots, renumbering triangles in their order (neighbours
   /// that were deleted become -1), and rebuilds vert_tri.

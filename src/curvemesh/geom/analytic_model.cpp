@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <utility>
 
@@ -72,6 +73,10 @@ struct RegionRecord {
   std::vector<OrientedUse> faces;
   double volume = 0.0;
   Vec3 center_of_mass = Vec3::Zero();
+  /// Exact signed Euclidean distance to the solid's boundary, negative
+  /// inside: comparing it with the tolerance gives classify_point's answer
+  /// with the same "on" band as every other query of the model.
+  std::function<double(const Vec3&)> signed_distance;
 };
 
 /// Relative size of the model tolerance: far above rounding (1e-16) so exact
@@ -105,6 +110,7 @@ class AnalyticModel final : public Model {
   Projection closest_point(EntityRef e, const Vec3& x, std::optional<Vec2> hint) const override;
   Vec2 edge_param_on_face(int edge, int face, double u, bool forward) const override;
   bool contains_param(int face, const Vec2& uv) const override;
+  Containment classify_point(int region, const Vec3& x) const override;
 
   double area(int face) const override { return face_record(face).surface->area(); }
   double length(int edge) const override { return edge_record(edge).curve->length(); }
@@ -352,6 +358,17 @@ bool AnalyticModel::contains_param(int face, const Vec2& uv) const {
   return face_record(face).surface->contains(uv, tolerance_);
 }
 
+Containment AnalyticModel::classify_point(int region, const Vec3& x) const {
+  const RegionRecord& r = region_record(region);
+  if (!x.allFinite())
+    throw std::invalid_argument(fmt::format("analytic model: classify_point at a non-finite point ({}, {}, {})",
+                                            x.x(), x.y(), x.z()));
+  const double d = r.signed_distance(x);
+  if (d < -tolerance_) return Containment::kInside;
+  if (d > tolerance_) return Containment::kOutside;
+  return Containment::kOn;
+}
+
 // --- factories ---------------------------------------------------------------
 
 bool is_finite(const Vec3& v) { return v.allFinite(); }
@@ -440,6 +457,7 @@ std::unique_ptr<Model> make_analytic_sphere(const Vec3& center, double radius) {
   regions[0].faces = {{1, true}};
   regions[0].volume = 4.0 / 3.0 * kPi * radius * radius * radius;
   regions[0].center_of_mass = center;
+  regions[0].signed_distance = [center, radius](const Vec3& x) { return (x - center).norm() - radius; };
   return std::make_unique<AnalyticModel>(std::vector<Vec3>{north, south}, std::move(edges),
                                          std::move(faces), std::move(regions));
 }
@@ -474,6 +492,15 @@ std::unique_ptr<Model> make_analytic_cylinder(const Vec3& base_center, const Vec
   regions[0].faces = {{1, true}, {2, true}, {3, false}};
   regions[0].volume = kPi * radius * radius * height;
   regions[0].center_of_mass = base_center + 0.5 * height * axis;
+  regions[0].signed_distance = [bottom, radius, height](const Vec3& x) {
+    // Distance to the box |radial| <= R, 0 <= axial <= H in the (radial,
+    // axial) half-plane: outside, the distance to the nearest of the lateral
+    // face, a cap or their rim; inside, minus the distance to the nearest face.
+    const Vec3 l = bottom.to_local(x);
+    const double radial = std::hypot(l.x(), l.y()) - radius;
+    const double axial = std::max(-l.z(), l.z() - height);
+    return std::min(std::max(radial, axial), 0.0) + std::hypot(std::max(radial, 0.0), std::max(axial, 0.0));
+  };
   return std::make_unique<AnalyticModel>(std::vector<Vec3>{top_vertex, bottom_vertex}, std::move(edges),
                                          std::move(faces), std::move(regions));
 }
@@ -504,6 +531,10 @@ std::unique_ptr<Model> make_analytic_torus(const Vec3& center, const Vec3& axis_
   regions[0].faces = {{1, true}};
   regions[0].volume = 2.0 * kPi * kPi * major_radius * minor_radius * minor_radius;
   regions[0].center_of_mass = center;
+  regions[0].signed_distance = [frame, major_radius, minor_radius](const Vec3& x) {
+    const Vec3 l = frame.to_local(x);
+    return std::hypot(std::hypot(l.x(), l.y()) - major_radius, l.z()) - minor_radius;
+  };
   return std::make_unique<AnalyticModel>(std::vector<Vec3>{vertex}, std::move(edges), std::move(faces),
                                          std::move(regions));
 }

@@ -10,9 +10,11 @@
 // order, normals, principal curvatures and directions, closest points
 // (clamped to the trimmed entity; the hint is used only to break ties such
 // as a probe on an axis or a parameter on a seam), p-curves, areas, lengths,
-// volume and centre of mass. Models are immutable, so queries are
-// thread-safe. Units are "" (unitless); every entity's tolerance is
-// 1e-9 × the model's bounding-box diagonal.
+// volume and centre of mass, and classify_point (the solid's exact signed
+// distance function compared with the tolerance, so kOn is the band of
+// that width around the whole boundary, rims included). Models are
+// immutable, so queries are thread-safe. Units are "" (unitless); every
+// entity's tolerance is 1e-9 × the model's bounding-box diagonal.
 //
 // Frames: for an axis a, the reference direction x = reference_x_direction(a)
 // and y = a × x (right-handed). The sphere uses the world frame (axis +Z).

@@ -94,6 +94,13 @@ struct Curvatures {
   Vec3 dir1 = Vec3::UnitX(), dir2 = Vec3::UnitY();
 };
 
+/// Where a point lies with respect to a region (classify_point).
+enum class Containment {
+  kOutside,
+  kOn,      ///< within the region's tolerance of its boundary
+  kInside,
+};
+
 /// Result of a closest-point query.
 struct Projection {
   Vec3 point;      ///< on the entity
@@ -150,6 +157,15 @@ class Model {
   virtual Vec2 edge_param_on_face(int edge, int face, double u, bool forward = true) const = 0;
   /// Whether (u, v) is inside the trimmed face (on its boundary counts as in).
   virtual bool contains_param(int face, const Vec2& uv) const = 0;
+  /// Where x lies with respect to the closed solid `region`: kOn within
+  /// tolerance({3, region}) of its boundary (so a point of a face two
+  /// regions share is kOn for both), else kInside or kOutside. Exact to
+  /// rounding on analytic models, O(1). On CAD models a few microseconds per
+  /// call on average, up to milliseconds for points close to a corner
+  /// (geom_occ/load.hpp); the first call on a region also prepares it (tens
+  /// to hundreds of milliseconds). Throws std::out_of_range for a
+  /// region that does not exist and std::invalid_argument for a non-finite x.
+  virtual Containment classify_point(int region, const Vec3& x) const = 0;
 
   // --- global properties (validation) -----------------------------------
   virtual double area(int face) const = 0;

@@ -2,6 +2,7 @@
 // need no CAD file. Every dimension is a parameter with a default.
 #include <charconv>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <string_view>
 #include <vector>
@@ -16,6 +17,7 @@
 #include <BRepPrimAPI_MakePrism.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
+#include <BRep_Builder.hxx>
 #include <GeomAPI_PointsToBSplineSurface.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Precision.hxx>
@@ -23,6 +25,7 @@
 #include <TColgp_Array2OfPnt.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
 #include <gp_Ax2.hxx>
 #include <gp_Pnt.hxx>
 #include <gp_Vec.hxx>
@@ -56,6 +59,13 @@ const std::vector<Builtin>& builtins() {
        "mechanical part: a 60x40x20 block (times scale) with filleted vertical edges, two "
        "through holes and a freeform B-spline top face",
        {{"scale", 1}}},
+      {"blocks",
+       "two regions sharing the face x = dx1: boxes [0,dx1] x [0,dy] x [0,dz] and "
+       "[dx1,dx1+dx2] x [0,dy] x [0,dz]",
+       {{"dx1", 1}, {"dx2", 1}, {"dy", 1}, {"dz", 1}}},
+      {"inclusion",
+       "two regions: a sphere of radius r inside the cube [-s/2,s/2]^3, and the rest of the cube",
+       {{"s", 2}, {"r", 0.5}}},
   };
   return kBuiltins;
 }
@@ -87,6 +97,16 @@ Params parse_params(const std::string& spec, const Builtin& b, std::string_view 
 
 void require(bool ok, const std::string& spec, std::string_view what) {
   if (!ok) throw InputError(spec, -1, -1, fmt::format("invalid parameters: {}", what));
+}
+
+// Separate solids: make_conformal_solids fuses them into conformal regions
+// (the shared face of two blocks, the sphere carved out of the cube).
+TopoDS_Shape make_compound(std::initializer_list<TopoDS_Shape> solids) {
+  TopoDS_Compound compound;
+  BRep_Builder builder;
+  builder.MakeCompound(compound);
+  for (const TopoDS_Shape& s : solids) builder.Add(compound, s);
+  return compound;
 }
 
 TopoDS_Shape make_part(double s) {
@@ -140,7 +160,7 @@ ReadShape make_builtin(const std::string& spec) {
   if (!b)
     throw InputError(spec, -1, -1,
                      fmt::format("unknown built-in model '{}' (box, sphere, cylinder, torus, "
-                                 "cone, part)",
+                                 "cone, part, blocks, inclusion)",
                                  name));
   const Params p = parse_params(spec, *b, list);
   const auto positive = [&](const char* key) {
@@ -163,6 +183,16 @@ ReadShape make_builtin(const std::string& spec) {
       const double r1 = p.at("r1"), r2 = p.at("r2");
       require(r1 >= 0 && r2 >= 0 && r1 != r2, spec, "r1, r2 must be >= 0 and different");
       out.shape = BRepPrimAPI_MakeCone(r1, r2, positive("h")).Shape();
+    } else if (name == "blocks") {
+      const double dx1 = positive("dx1"), dx2 = positive("dx2"), dy = positive("dy"), dz = positive("dz");
+      out.shape = make_compound({BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), dx1, dy, dz).Shape(),
+                                 BRepPrimAPI_MakeBox(gp_Pnt(dx1, 0, 0), dx2, dy, dz).Shape()});
+    } else if (name == "inclusion") {
+      const double side = positive("s"), r = positive("r");
+      require(2 * r < side, spec, "the sphere (2r) must fit inside the cube (s)");
+      const double h = side / 2;
+      out.shape = make_compound({BRepPrimAPI_MakeBox(gp_Pnt(-h, -h, -h), side, side, side).Shape(),
+                                 BRepPrimAPI_MakeSphere(r).Shape()});
     } else {
       out.shape = make_part(positive("scale"));
     }

@@ -128,6 +128,7 @@ OccModel::OccModel(const TopoDS_Shape& solids, std::string units) : units_(std::
   build_faces(solids, maps);
   face_areas_ = std::make_unique<Lazy<double>[]>(faces_.size());
   region_mass_ = std::make_unique<Lazy<MassProperties>[]>(regions_.size());
+  region_meshes_ = std::make_unique<Lazy<RegionMesh>[]>(regions_.size());
   for (const RegionData& r : regions_) {
     box_.add(r.box.min);
     box_.add(r.box.max);

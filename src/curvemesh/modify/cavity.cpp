@@ -10,6 +10,7 @@
 namespace cm::modify {
 
 namespace {
+constexpr int kNext[4] = {1, 2, 0, 1};  // (k + 1) % 3 for k < 4
 constexpr Index kBoundaryBit = Index{1} << 31;
 
 std::array<VertId, 3> sorted(std::array<VertId, 3> k) {
@@ -151,76 +152,162 @@ Refusal check_star(const mesh::TetMesh& m, const Cavity& cav, VertId p) {
   return Refusal::kNone;
 }
 
+// Links the star faces (Cavity::side_) through a matrix indexed by the
+// boundary's local vertex numbers: a boundary of nb faces that is a closed
+// surface has nb / 2 + 2 vertices, under 64 for all but huge cavities, so
+// directed edge a -> b has a cell of its own and nothing is hashed or
+// searched. Local numbers come from a per-vertex tag (generation | number),
+// so nothing is cleared per call; cells are reset as they are read. Returns
+// false (nothing linked) when the boundary has too many vertices.
+bool link_star_by_local_edges(mesh::TetMesh& m, Cavity& cav) {
+  constexpr std::uint32_t kMaxLocal = 64;
+  constexpr std::uint16_t kEmpty = 0xFFFF;
+  const std::size_t nb = cav.boundary_.size();
+  if (nb > 2 * kMaxLocal - 4) return false;
+  if (cav.local_.size() < m.coords.size())
+    cav.local_.resize(m.coords.size() + m.coords.size() / 4, 0);
+  if (cav.edge_cell_.empty()) cav.edge_cell_.assign(kMaxLocal * kMaxLocal, kEmpty);
+  if (++cav.local_generation_ >= (1u << 26)) {  // the tags would wrap
+    std::fill(cav.local_.begin(), cav.local_.end(), 0);
+    cav.local_generation_ = 1;
+  }
+  const std::uint32_t tag = cav.local_generation_ << 6;
+  // Raw pointers, and numbers stored as 32-bit words: stores through
+  // std::uint8_t (a character type) would make the compiler reload every
+  // pointer after each.
+  std::uint32_t* const local = cav.local_.data();
+  const CavityFace* const faces = cav.boundary_.data();
+  cav.local_ids_.resize(nb);
+  std::array<std::uint32_t, 3>* const ids = cav.local_ids_.data();
+  std::uint32_t count = 0;
+  for (std::size_t i = 0; i < nb; ++i)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t& x = local[faces[i].verts[k]];
+      if ((x & ~63u) != tag) {
+        if (count == kMaxLocal) return false;  // not a closed surface
+        x = tag | count++;
+      }
+      ids[i][k] = x & 63u;
+    }
+  // Directed edge a -> b has cell a << 6 | b.
+  std::uint16_t* const cell = cav.edge_cell_.data();
+  for (std::size_t i = 0; i < nb; ++i) {
+    const auto [a, b, c] = ids[i];
+    cell[b << 6 | c] = static_cast<std::uint16_t>(3 * i);
+    cell[c << 6 | a] = static_cast<std::uint16_t>(3 * i + 1);
+    cell[a << 6 | b] = static_cast<std::uint16_t>(3 * i + 2);
+  }
+  bool closed = true;
+  const Index* const side = cav.side_.data();
+  Index* const adj = m.tet2adj.data();
+  auto link = [&](std::size_t here, std::uint32_t reversed) {
+    const std::uint16_t there = cell[reversed];
+    cell[reversed] = kEmpty;
+    closed &= there != kEmpty;
+    adj[side[here]] = there != kEmpty ? side[there] : kNone;
+  };
+  for (std::size_t i = 0; i < nb; ++i) {
+    const auto [a, b, c] = ids[i];
+    link(3 * i, c << 6 | b);
+    link(3 * i + 1, a << 6 | c);
+    link(3 * i + 2, b << 6 | a);
+  }
+  if (!closed) throw std::logic_error("fill_star: the star does not tile the cavity");
+  return true;
+}
+
+// The same for any boundary: directed edges in a hash of chains (heads
+// cleared per call, entries in order).
+void link_star_by_hashed_edges(mesh::TetMesh& m, Cavity& cav) {
+  const std::size_t nb = cav.boundary_.size();
+  int bits = 9;
+  while ((std::size_t{1} << bits) < 6 * nb) ++bits;
+  cav.edge_heads_.assign(std::size_t{1} << bits, -1);
+  cav.edge_entries_.resize(3 * nb);
+  auto hash = [bits](VertId u, VertId w) {
+    return static_cast<std::size_t>((u * 0x9E3779B1u) ^ (w * 0x85EBCA77u)) >> (32 - bits);
+  };
+  for (std::size_t i = 0; i < nb; ++i) {
+    const CavityFace& bf = cav.boundary_[i];
+    for (int k = 0; k < 3; ++k) {
+      const VertId u = bf.verts[kNext[k]], w = bf.verts[kNext[k + 1]];
+      const std::size_t e = 3 * i + static_cast<std::size_t>(k);
+      std::int32_t& head = cav.edge_heads_[hash(u, w)];
+      cav.edge_entries_[e] = {u, w, head};
+      head = static_cast<std::int32_t>(e);
+    }
+  }
+  for (std::size_t e = 0; e < 3 * nb; ++e) {
+    const Cavity::EdgeEntry& x = cav.edge_entries_[e];
+    std::int32_t k = cav.edge_heads_[hash(x.b, x.a)];
+    while (k >= 0 && !(cav.edge_entries_[k].a == x.b && cav.edge_entries_[k].b == x.a))
+      k = cav.edge_entries_[k].next;
+    if (k < 0) throw std::logic_error("fill_star: the star does not tile the cavity");
+    m.tet2adj[cav.side_[e]] = cav.side_[static_cast<std::size_t>(k)];
+  }
+}
+
 std::span<const TetId> fill_star(MeshEditor& ed, Cavity& cav, VertId p) {
   auto& m = ed.mesh();
-  cav.star_.clear();
+  const std::size_t nb = cav.boundary_.size();
+  // New tet i keeps boundary face i, with the local numbering of the cavity
+  // tet it came from (p in the slot facing the face), so the face keeps its
+  // orientation and the tet is positive. Regions are read now: released slots
+  // are reused below.
+  cav.star_.resize(nb);
   bool touches_p = false;
-  for (const CavityFace& f : cav.boundary()) {
-    if (f.verts[0] == p || f.verts[1] == p || f.verts[2] == p) {
-      touches_p = true;
-      continue;
-    }
+  for (std::size_t i = 0; i < nb; ++i) {
+    const CavityFace& f = cav.boundary_[i];
+    touches_p |= f.verts[0] == p || f.verts[1] == p || f.verts[2] == p;
     const TetId t = mesh::face_tet(f.inside);
-    NewTet nt{m.tet2verts[t], m.tet_region[t]};
-    // Same local numbering as the cavity tet, so face f keeps its orientation.
+    NewTet& nt = cav.star_[i];
+    nt.verts = m.tet2verts[t];
     nt.verts[mesh::face_index(f.inside)] = p;
-    cav.star_.push_back(nt);
+    nt.region = m.tet_region[t];
   }
-  // A boundary face through p (a collapse) is matched by a star face: the
-  // general face matching handles it.
-  if (touches_p) return rebuild(ed, cav, cav.star_);
+  if (touches_p) {
+    // A boundary face through p (a collapse) is matched by a star face: the
+    // general face matching handles it.
+    std::erase_if(cav.star_, [p](const NewTet& nt) {
+      int with_p = 0;
+      for (VertId v : nt.verts) with_p += v == p;
+      return with_p > 1;
+    });
+    return rebuild(ed, cav, cav.star_);
+  }
 
-  // Insertion, split, relocation: new tet i keeps boundary face i and its
-  // three other faces hold p and one edge of face i, shared with exactly one
-  // other new tet. Matching those by edge is all the linking there is — the
-  // hot path of Delaunay insertion.
-  const std::size_t n = cav.star_.size();
-  std::size_t cap = 16;
-  while (cap < 4 * n) cap *= 2;
-  cav.edge_table_.assign(cap, {kNone, kNone, kNone});
-  const std::size_t mask = cap - 1;
-  cav.verts_.clear();
-  for (TetId t : cav.tets_) {
-    for (VertId v : m.tet2verts[t]) cav.verts_.push_back(v);
-    ed.release(t);
-  }
-  cav.created_.clear();
-  std::size_t bi = 0;
-  for (const CavityFace& bf : cav.boundary_) {
-    const NewTet& nt = cav.star_[bi++];
+  // Insertion, split, relocation: the three other faces of new tet i hold p
+  // and one edge of boundary face i, and are shared with the new tet of the
+  // boundary face across that edge. So matching edges of the boundary is all
+  // the linking there is — the hot path of Delaunay insertion. The boundary
+  // is a closed surface with faces oriented out of the cavity, so edge u -> w
+  // of one face is w -> u in its neighbour: every directed edge is recorded
+  // first, then every star face looks up its reversed edge.
+  //
+  // Vertices of the cavity lose their seed, and those in new tets get one
+  // back from allocate(): a vertex strictly inside the cavity (on no boundary
+  // face, never one of a Delaunay insertion) is left with none.
+  if (!ed.seeds_deferred())
+    for (TetId t : cav.tets_)
+      for (VertId v : m.tet2verts[t]) m.vert2tet[v] = kNone;
+  for (TetId t : cav.tets_) ed.release(t);
+  cav.created_.resize(nb);
+  // side_[3 i + k]: the star face of new tet i opposite boundary vertex k; it
+  // holds p and the edge k+1 -> k+2 of boundary face i.
+  cav.side_.resize(3 * nb);
+  for (std::size_t i = 0; i < nb; ++i) {
+    const CavityFace& bf = cav.boundary_[i];
+    const NewTet& nt = cav.star_[i];
     const TetId t = ed.allocate(nt.verts, nt.region);
-    cav.created_.push_back(t);
+    cav.created_[i] = t;
     const int fb = mesh::face_index(bf.inside);
-    m.tet2adj[mesh::pack_face(t, fb)] = bf.outside;
-    if (bf.marked) ed.set_face_mark_one_side(mesh::pack_face(t, fb), true);
-    if (bf.outside != kNone) m.tet2adj[bf.outside] = mesh::pack_face(t, fb);
-    for (int f = 0; f < 4; ++f) {
-      if (f == fb) continue;
-      // Face f holds p (at slot fb) and the two vertices other than f, fb.
-      VertId a = kNone, b = kNone;
-      for (int k = 0; k < 4; ++k)
-        if (k != f && k != fb) (a == kNone ? a : b) = nt.verts[k];
-      if (a > b) std::swap(a, b);
-      const Index here = mesh::pack_face(t, f);
-      for (std::size_t h = (std::size_t{a} * 0x9E3779B1u ^ std::size_t{b} * 0x85EBCA77u) & mask;; h = (h + 1) & mask) {
-        auto& slot = cav.edge_table_[h];
-        if (slot[0] == kNone) {
-          slot = {a, b, here};
-          break;
-        }
-        if (slot[0] == a && slot[1] == b && slot[2] != kNone) {
-          m.tet2adj[here] = slot[2];
-          m.tet2adj[slot[2]] = here;
-          slot[2] = kNone;  // matched; the key stays so probe chains hold
-          break;
-        }
-      }
-    }
+    const Index base = mesh::pack_face(t, fb);
+    m.tet2adj[base] = bf.outside;
+    if (bf.outside != kNone) m.tet2adj[bf.outside] = base;
+    if (bf.marked) ed.set_face_mark_one_side(base, true);
+    for (int k = 0; k < 3; ++k) cav.side_[3 * i + k] = mesh::pack_face(t, mesh::kFaceVerts[fb][k]);
   }
-  for (VertId v : cav.verts_) {
-    const TetId s = m.vert2tet[v];
-    if (s != kNone && (ed.is_dead(s) || mesh::local_index(m, s, v) < 0)) m.vert2tet[v] = kNone;
-  }
+  if (!link_star_by_local_edges(m, cav)) link_star_by_hashed_edges(m, cav);
   if (ed.hook()) ed.hook()(m, cav.created_);
   return cav.created_;
 }

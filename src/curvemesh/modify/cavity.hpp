@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "curvemesh/mesh/topology.hpp"
 #include "curvemesh/modify/mesh_editor.hpp"
 
 namespace cm::modify {
@@ -65,6 +66,17 @@ class Cavity {
   std::span<const CavityFace> compute_boundary(const MeshEditor& ed);
   std::span<const CavityFace> boundary() const { return boundary_; }
 
+  /// Grows the cavity from `seed` (added first) face by face: each neighbour
+  /// of a cavity tet is tested once with in_conflict(n) and joins when that
+  /// is true (rejected ones are stamped, MeshEditor::mark_rejected). With
+  /// `keep_marked_faces`, protected faces are never crossed. The boundary is
+  /// recorded on the way, so boundary() is valid afterwards without
+  /// compute_boundary(). Returns false if a protected face still ends up with
+  /// both its tets in the cavity (reached around it): filling would delete
+  /// it. Only right after reset().
+  template <class InConflict>
+  bool grow(MeshEditor& ed, TetId seed, InConflict&& in_conflict, bool keep_marked_faces);
+
  private:
   friend std::span<const TetId> rebuild(MeshEditor&, Cavity&, std::span<const NewTet>);
   friend std::span<const TetId> fill_star(MeshEditor&, Cavity&, VertId);
@@ -78,9 +90,92 @@ class Cavity {
   std::vector<Slot> table_;
   std::vector<TetId> created_;
   std::vector<VertId> verts_;
-  std::vector<std::array<VertId, 3>> edge_table_;  // (a, b, packed face) for star fills
   std::vector<NewTet> star_;
+  // Star fills (see fill_star): the new tets' faces through p, and the
+  // matching of the boundary's directed edges, by local vertex numbers or by
+  // hashing.
+  friend bool link_star_by_local_edges(mesh::TetMesh&, Cavity&);
+  friend void link_star_by_hashed_edges(mesh::TetMesh&, Cavity&);
+  std::vector<Index> side_;
+  std::vector<std::uint32_t> local_;  // per vertex: generation << 6 | number
+  std::uint32_t local_generation_ = 0;
+  std::vector<std::array<std::uint32_t, 3>> local_ids_;  // per boundary face
+  std::vector<std::uint16_t> edge_cell_;
+  struct EdgeEntry {
+    VertId a, b;        // the edge a -> b
+    std::int32_t next;  // next entry of the bucket, or -1
+  };
+  std::vector<std::int32_t> edge_heads_;
+  std::vector<EdgeEntry> edge_entries_;
 };
+
+template <class InConflict>
+bool Cavity::grow(MeshEditor& ed, TetId seed, InConflict&& in_conflict, bool keep_marked_faces) {
+  const auto& m = ed.mesh();
+  add(ed, seed);
+  // The hot loop of Delaunay insertion: raw views of arrays that do not
+  // change while it runs, and the stamps read directly (every tet has one).
+  ed.grow_stamps();
+  std::uint32_t* const stamp = ed.stamps_.data();
+  const std::uint32_t member = ed.epoch_, rejected = ed.epoch_ + 1;
+  const Index* const adj_all = m.tet2adj.data();
+  const std::array<VertId, 4>* const verts = m.tet2verts.data();
+  bool blocked = false;
+  // Breadth first, tets_ being the queue: a tet's neighbours are examined a
+  // while after it joined, so the loads prefetched then have landed.
+  for (std::size_t next = tets_.size() - 1; next < tets_.size(); ++next) {
+    const TetId t = tets_[next];
+    const Index* const at = adj_all + 4 * std::size_t{t};
+    const std::array<Index, 4> adj{at[0], at[1], at[2], at[3]};
+    // The neighbours may be scattered in memory: start the loads of their
+    // stamps and vertices before testing any, so that misses overlap.
+    for (const Index a : adj)
+      if (a != kNone) {
+        __builtin_prefetch(&stamp[mesh::face_tet(a)]);
+        __builtin_prefetch(&verts[mesh::face_tet(a)]);
+      }
+    const std::array<VertId, 4> tv = verts[t];
+    for (int f = 0; f < 4; ++f) {
+      const Index here = mesh::pack_face(t, f);
+      const Index across = adj[f];
+      if (across != kNone) {
+        const TetId n = mesh::face_tet(across);
+        const std::uint32_t s = stamp[n];
+        if (s == member) continue;  // an inner face
+        const bool stop = keep_marked_faces && ed.face_marked(here);
+        blocked |= stop;
+        if (!stop && s != rejected) {
+          if (in_conflict(n)) {
+            stamp[n] = member;
+            tets_.push_back(n);
+            // Read next (its neighbours) and by a fill (its region).
+            __builtin_prefetch(&adj_all[mesh::pack_face(n, 0)]);
+            __builtin_prefetch(&m.tet_region[n]);
+            continue;
+          }
+          stamp[n] = rejected;
+        }
+        __builtin_prefetch(&adj_all[across], 1);  // a fill relinks it
+      }
+      // Face f of t holds the three vertices other than f, in kFaceVerts order.
+      const auto& fv = mesh::kFaceVerts[f];
+      boundary_.push_back({{tv[fv[0]], tv[fv[1]], tv[fv[2]]}, here, across, ed.face_marked(here)});
+    }
+  }
+  if (!blocked) return true;
+  // A protected face is on the boundary only if its far tet stayed out.
+  std::size_t kept = 0;
+  bool crossed = false;
+  for (const CavityFace& bf : boundary_) {
+    if (bf.outside != kNone && ed.marked(mesh::face_tet(bf.outside))) {
+      crossed = true;
+      continue;
+    }
+    boundary_[kept++] = bf;
+  }
+  boundary_.resize(kept);
+  return !crossed;
+}
 
 /// Replaces the cavity's tets by `fill`. The fill must tile exactly the
 /// cavity: every face of a new tet is either a boundary face of the cavity

@@ -14,22 +14,37 @@ MeshEditor::MeshEditor(mesh::TetMesh& m) : m_(&m) {
   std::sort(free_.rbegin(), free_.rend());
 }
 
-TetId MeshEditor::allocate(const std::array<VertId, 4>& v, std::int32_t region) {
-  TetId t;
-  if (!free_.empty()) {
-    t = free_.back();
-    free_.pop_back();
-    m_->tet2verts[t] = v;
-    m_->tet_region[t] = region;
-    for (int f = 0; f < 4; ++f) m_->tet2adj[4 * t + f] = kNone;
-  } else {
-    t = static_cast<TetId>(m_->tet2verts.size());
-    m_->tet2verts.push_back(v);
-    m_->tet_region.push_back(region);
-    m_->tet2adj.insert(m_->tet2adj.end(), 4, kNone);
+void MeshEditor::reserve(std::size_t tets) {
+  auto& m = *m_;
+  m.tet2verts.reserve(tets);
+  m.tet_region.reserve(tets);
+  m.tet2adj.reserve(4 * tets);
+  stamps_.reserve(tets + tets / 2 + 16);
+}
+
+void MeshEditor::defer_seeds(bool on) {
+  if (on == seeds_deferred_) return;
+  seeds_deferred_ = on;
+  if (on) return;
+  auto& m = *m_;
+  m.vert2tet.assign(m.coords.size(), kNone);
+  for (TetId t = 0; t < m.tet2verts.size(); ++t)
+    if (!is_dead(t))
+      for (VertId v : m.tet2verts[t]) m.vert2tet[v] = t;
+}
+
+TetId MeshEditor::append(const std::array<VertId, 4>& v, std::int32_t region) {
+  auto& m = *m_;
+  const auto t = static_cast<TetId>(m.tet2verts.size());
+  if (m.tet2verts.size() == m.tet2verts.capacity()) {
+    const std::size_t cap = m.tet2verts.size() + m.tet2verts.size() / 2 + 64;
+    m.tet2verts.reserve(cap);
+    m.tet_region.reserve(cap);
+    m.tet2adj.reserve(4 * cap);
   }
-  if (m_->vert2tet.size() < m_->coords.size()) m_->vert2tet.resize(m_->coords.size(), kNone);
-  for (VertId x : v) m_->vert2tet[x] = t;
+  m.tet2verts.push_back(v);
+  m.tet_region.push_back(region);
+  m.tet2adj.insert(m.tet2adj.end(), 4, kNone);
   return t;
 }
 
@@ -49,14 +64,10 @@ void MeshEditor::set_face_mark_one_side(Index packed, bool on) {
   face_marks_[t] = on ? (face_marks_[t] | bit) : (face_marks_[t] & ~bit);
 }
 
-void MeshEditor::release(TetId t) {
-  m_->tet2verts[t][0] = kNone;
-  if (t < face_marks_.size()) face_marks_[t] = 0;
-  free_.push_back(t);
-}
-
 std::uint32_t MeshEditor::next_epoch() {
-  if (++epoch_ == 0) {  // wrapped: old stamps could alias the new epoch
+  // Two stamp values per epoch (member, rejected), so epochs step by 2.
+  epoch_ += 2;
+  if (epoch_ >= 0xFFFFFFF0u) {  // about to wrap: old stamps could alias a new epoch
     std::fill(stamps_.begin(), stamps_.end(), 0);
     epoch_ = 1;
   }

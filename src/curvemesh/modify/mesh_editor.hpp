@@ -40,11 +40,45 @@ class MeshEditor {
   bool is_dead(TetId t) const { return m_->tet2verts[t][0] == kNone; }
   std::size_t live_tets() const { return m_->tet2verts.size() - free_.size(); }
 
-  /// A slot for a new tet (reusing a dead one when possible). Adjacency of
-  /// the new tet is all kNone; the caller links it.
-  TetId allocate(const std::array<VertId, 4>& v, std::int32_t region);
+  /// A slot for a new tet (reusing a dead one when possible, the last
+  /// released first). Adjacency of the new tet is all kNone; the caller links
+  /// it. Inline: Delaunay insertion calls it some 30 times per point.
+  TetId allocate(const std::array<VertId, 4>& v, std::int32_t region) {
+    auto& m = *m_;
+    TetId t;
+    if (!free_.empty()) [[likely]] {
+      t = free_.back();
+      free_.pop_back();
+      m.tet2verts[t] = v;
+      m.tet_region[t] = region;
+      for (int f = 0; f < 4; ++f) m.tet2adj[4 * std::size_t{t} + f] = kNone;
+    } else {
+      t = append(v, region);
+    }
+    if (!seeds_deferred_) {
+      if (m.vert2tet.size() < m.coords.size()) [[unlikely]]
+        m.vert2tet.resize(m.coords.size(), kNone);
+      for (VertId x : v) m.vert2tet[x] = t;
+    }
+    return t;
+  }
   /// Marks t dead. Its adjacency entries are left for the caller to rewire.
-  void release(TetId t);
+  void release(TetId t) {
+    m_->tet2verts[t][0] = kNone;
+    if (t < face_marks_.size()) face_marks_[t] = 0;
+    free_.push_back(t);
+  }
+  /// Reserves room for `tets` tets in the mesh's per-tet arrays (and the
+  /// stamps), so that a bulk construction does not reallocate (each
+  /// reallocation copies everything and briefly holds both copies).
+  void reserve(std::size_t tets);
+
+  /// Bulk construction: while seeds are deferred, vert2tet is not kept (the
+  /// editor's contract on it is suspended; nothing may read it), which spares
+  /// a scattered write per vertex of every new tet. Turning deferral off
+  /// rebuilds vert2tet from the live tets in one pass.
+  void defer_seeds(bool on);
+  bool seeds_deferred() const { return seeds_deferred_; }
 
   /// Stamps: stamp(t) == epoch() means "marked in the current operation".
   /// next_epoch() invalidates every mark in O(1).
@@ -52,6 +86,11 @@ class MeshEditor {
   std::uint32_t epoch() const { return epoch_; }
   void mark(TetId t) { grow_stamps(); stamps_[t] = epoch_; }
   bool marked(TetId t) const { return t < stamps_.size() && stamps_[t] == epoch_; }
+  /// A second mark of the same epoch, exclusive with mark(): "examined by the
+  /// current operation and left out" (the neighbours a Delaunay cavity
+  /// rejected, so that none is tested twice).
+  void mark_rejected(TetId t) { grow_stamps(); stamps_[t] = epoch_ + 1; }
+  bool rejected(TetId t) const { return t < stamps_.size() && stamps_[t] == epoch_ + 1; }
 
   /// Face marks: a protected face (a boundary triangle a cavity must not
   /// cross or remove). Stored on both tets sharing the face; cavity rebuilds
@@ -73,15 +112,25 @@ class MeshEditor {
   std::vector<TetId> compact();
 
  private:
+  // The cavity kernel's hot loop (Cavity::grow) reads and writes the stamps
+  // directly.
+  friend class Cavity;
+
   void grow_stamps() {
     if (stamps_.size() < m_->tet2verts.size()) stamps_.resize(m_->tet2verts.size() + m_->tet2verts.size() / 2 + 16, 0);
   }
+  // A new slot at the end, adjacency kNone. The per-tet arrays grow by half
+  // rather than doubling: past a reserve() that fell short, the last
+  // reallocation of a big mesh then over-allocates and transiently holds less.
+  TetId append(const std::array<VertId, 4>& v, std::int32_t region);
 
   mesh::TetMesh* m_;
   std::vector<TetId> free_;
   std::vector<std::uint32_t> stamps_;
   std::vector<std::uint8_t> face_marks_;
+  // Odd: epoch_ marks a member, epoch_ + 1 a rejected tet (see next_epoch).
   std::uint32_t epoch_ = 1;
+  bool seeds_deferred_ = false;
   RebuildHook hook_;
 };
 

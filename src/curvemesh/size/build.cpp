@@ -1,14 +1,99 @@
 #include "curvemesh/size/build.hpp"
 
+#include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <mutex>
 #include <stdexcept>
+#include <unordered_map>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include "curvemesh/core/error.hpp"
 #include "curvemesh/core/timer.hpp"
 
 namespace cm::size {
+
+namespace {
+
+const char* entity_name(int dim) {
+  static const char* const kNames[] = {"vertex", "edge", "face", "region"};
+  return dim >= 0 && dim <= 3 ? kNames[dim] : "entity";
+}
+
+/// h inside a region and on its boundary, no request (+inf) elsewhere: what
+/// the octree evaluates at its corners and centres to honour a size on a
+/// region. The corners of every octant inside the region get h, so its
+/// interior is at most h there; an octant the boundary crosses is covered by
+/// the boundary's own samples (sample_entity_size).
+///
+/// The octree evaluates its fields afresh on every refinement round, at
+/// corners that mostly survive from the round before, and a point-in-solid
+/// test near a CAD boundary costs tens of microseconds: answers are kept,
+/// keyed by the point's exact coordinates (the octree computes a corner
+/// from integers, so the same corner is the same bits every round).
+class RegionSizeField final : public SizeField {
+ public:
+  RegionSizeField(const geom::Model& model, int region, double h) : model_(model), region_(region), h_(h) {
+    // Padded: the box only spares classifier calls far from the region, and
+    // a face box found by sampling may be a little tight.
+    const geom::BoundingBox b = model.bounding_box({3, region});
+    const Vec3 pad = Vec3::Constant(1e-3 * b.diagonal() + model.tolerance({3, region}));
+    lo_ = b.min - pad;
+    hi_ = b.max + pad;
+  }
+
+  double size(const Vec3& x, const SizeHint& = {}) const override {
+    constexpr double kNone = std::numeric_limits<double>::infinity();
+    if ((x.array() < lo_.array()).any() || (x.array() > hi_.array()).any()) return kNone;
+    const Key key{std::bit_cast<std::uint64_t>(x.x()), std::bit_cast<std::uint64_t>(x.y()),
+                  std::bit_cast<std::uint64_t>(x.z())};
+    Shard& shard = shards_[KeyHash{}(key) % kShards];
+    {
+      const std::lock_guard<std::mutex> lock(shard.mutex);
+      if (const auto it = shard.inside.find(key); it != shard.inside.end()) return it->second ? h_ : kNone;
+    }
+    bool inside = true;
+    try {
+      inside = model_.classify_point(region_, x) != geom::Containment::kOutside;
+    } catch (const GeometryError&) {
+      // The CAD classifier found no usable ray here. A finer size than
+      // needed is harmless; failing the whole field for one point is not.
+    }
+    const std::lock_guard<std::mutex> lock(shard.mutex);
+    shard.inside.emplace(key, inside);
+    return inside ? h_ : kNone;
+  }
+
+ private:
+  using Key = std::array<std::uint64_t, 3>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = k[0] * 0x9E3779B97F4A7C15ull;
+      h = (h ^ (h >> 29) ^ k[1]) * 0xBF58476D1CE4E5B9ull;
+      h = (h ^ (h >> 31) ^ k[2]) * 0x94D049BB133111EBull;
+      return static_cast<std::size_t>(h ^ (h >> 32));
+    }
+  };
+  // Sharded so that the octree's parallel evaluation rarely waits on a lock.
+  static constexpr std::size_t kShards = 64;
+  struct Shard {
+    std::mutex mutex;
+    std::unordered_map<Key, bool, KeyHash> inside;
+  };
+
+  const geom::Model& model_;
+  int region_;
+  double h_;
+  Vec3 lo_, hi_;
+  mutable std::array<Shard, kShards> shards_;
+};
+
+}  // namespace
 
 SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& o) {
   SizeFieldResult r;
@@ -22,13 +107,17 @@ SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& o)
     throw std::invalid_argument(fmt::format("hmin ({}) must not exceed hmax ({})", r.hmin, r.hmax));
   if (!(o.hgrad >= 1)) throw std::invalid_argument(fmt::format("hgrad must be >= 1 (got {})", o.hgrad));
   for (const auto& [e, h] : o.entity_sizes) {
-    if (e.dim < 0 || e.dim > 2 || e.tag < 1 || e.tag > model.count(e.dim))
-      throw std::invalid_argument(fmt::format("size on {} {}: the model has no such entity",
-                                              e.dim == 0   ? "vertex"
-                                              : e.dim == 1 ? "edge"
-                                              : e.dim == 2 ? "face"
-                                                           : "entity",
-                                              e.tag));
+    if (e.dim < 0 || e.dim > 3)
+      throw std::invalid_argument(fmt::format("size on an entity of dimension {}: a size goes on a vertex, an edge, "
+                                              "a face or a region (dimension 0-3)",
+                                              e.dim));
+    if (e.tag < 1 || e.tag > model.count(e.dim)) {
+      const int n = model.count(e.dim);
+      throw std::invalid_argument(
+          fmt::format("size on {} {}: the model has no such entity ({})", entity_name(e.dim), e.tag,
+                      n == 0 ? fmt::format("it has no {}", entity_name(e.dim))
+                             : fmt::format("{} tags are 1..{}", entity_name(e.dim), n)));
+    }
     if (!(h > 0) || !std::isfinite(h))
       throw std::invalid_argument(fmt::format("size on entity {}:{} must be finite and > 0", e.dim, e.tag));
   }
@@ -80,6 +169,8 @@ SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& o)
   for (const SizeSample& sm : r.samples)
     if (sm.size < r.hmax) r.octree->insert(sm.point, sm.size, sm.source);
   for (const auto& f : o.fields) r.octree->insert_field(f);
+  for (const auto& [e, h] : o.entity_sizes)
+    if (e.dim == 3) r.octree->insert_field(std::make_shared<RegionSizeField>(model, e.tag, h));
   r.octree->build();
   r.octree_seconds = octree_timer.seconds();
 
@@ -96,11 +187,33 @@ ModelSizeField::ModelSizeField(const geom::Model& model, const SizeOptions& o, d
       directional_(o.directional && o.curvature.enabled()),
       hmin_(hmin),
       hmax_(hmax),
+      vertex_size_(model.count(0) + 1, std::numeric_limits<double>::infinity()),
+      edge_size_(model.count(1) + 1, std::numeric_limits<double>::infinity()),
       face_size_(model.count(2) + 1, std::numeric_limits<double>::infinity()),
-      edge_size_(model.count(1) + 1, std::numeric_limits<double>::infinity()) {
+      region_size_(model.count(3) + 1, std::numeric_limits<double>::infinity()) {
+  const auto lower = [](double& to, double h) { to = std::min(to, h); };
   for (const auto& [e, h] : o.entity_sizes) {
-    if (e.dim == 2) face_size_[e.tag] = std::min(face_size_[e.tag], h);
-    if (e.dim == 1) edge_size_[e.tag] = std::min(edge_size_[e.tag], h);
+    switch (e.dim) {
+      case 0: lower(vertex_size_[e.tag], h); break;
+      case 1: lower(edge_size_[e.tag], h); break;
+      case 2: lower(face_size_[e.tag], h); break;
+      case 3: {
+        // A size inside a region holds on its closure: a boundary point
+        // queried with its face, edge or vertex as hint gets it too.
+        lower(region_size_[e.tag], h);
+        for (const geom::OrientedUse& face : model.region_faces(e.tag)) {
+          lower(face_size_[face.tag], h);
+          for (const geom::Loop& loop : model.face_loops(face.tag))
+            for (const geom::OrientedUse& edge : loop.edges) {
+              lower(edge_size_[edge.tag], h);
+              for (const int v : model.edge_vertices(edge.tag))
+                if (v > 0) lower(vertex_size_[v], h);
+            }
+        }
+        break;
+      }
+      default: break;
+    }
   }
 }
 
@@ -127,6 +240,10 @@ double ModelSizeField::hint_size(const SizeHint& hint) const {
       const double k = model_.edge_curvature(e.tag, hint.param.x());
       if (std::isfinite(k)) h = std::min(h, curvature_length(k, rule_));
     }
+  } else if (e.dim == 0 && e.tag >= 1 && e.tag <= model_.count(0)) {
+    h = vertex_size_[e.tag];
+  } else if (e.dim == 3 && e.tag >= 1 && e.tag <= model_.count(3)) {
+    h = region_size_[e.tag];
   }
   return h;
 }

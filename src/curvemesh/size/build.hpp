@@ -22,6 +22,11 @@ struct SizeOptions {
   double hgrad = 1.3;
   /// Default: ε = αℓ with α = 0.04 (eq. 4.5), about 20 edges per circle.
   CurvatureRule curvature = CurvatureRule::relative_deviation(0.04);
+  /// Sizes on model entities: (dim, tag) with dim 0-3 and h. A vertex, edge
+  /// or face gets h at points sampled on it; a region gets h everywhere
+  /// inside it and on its boundary (octree corners that classify_point puts
+  /// inside or on, plus samples of its faces and edges), and so does every
+  /// face, edge and vertex of its closure at hinted queries.
   std::vector<std::pair<geom::EntityRef, double>> entity_sizes;
   /// Isotropic (or the smallest size of anisotropic) sources, graded in the octree.
   std::vector<std::shared_ptr<const SizeField>> fields;
@@ -50,7 +55,10 @@ struct SizeOptions {
 /// the curvature evaluated exactly there and any size set on that entity
 /// (seed §4 step 1: "obtain principal curvature at each node point generated
 /// on the model face"), so sizes on the boundary are the formulas' values,
-/// not an interpolation of them. The model must outlive the field.
+/// not an interpolation of them. Sizes on entities (SizeOptions::entity_sizes)
+/// apply at hints on a vertex, edge or face (parameters then unused for a
+/// vertex), and a region's size at hints on the region itself or on any
+/// entity of its closure. The model must outlive the field.
 class ModelSizeField final : public SizeField {
  public:
   ModelSizeField(const geom::Model& model, const SizeOptions& options, double hmin, double hmax,
@@ -68,7 +76,8 @@ class ModelSizeField final : public SizeField {
   CurvatureRule rule_;
   bool directional_;
   double hmin_, hmax_;
-  std::vector<double> face_size_, edge_size_;  // user sizes per tag (+inf: none)
+  // User sizes per tag (+inf: none), a region's included on its closure.
+  std::vector<double> vertex_size_, edge_size_, face_size_, region_size_;
 };
 
 struct SizeFieldResult {
@@ -81,7 +90,9 @@ struct SizeFieldResult {
 };
 
 /// Throws std::invalid_argument for inconsistent options (hmin > hmax,
-/// hgrad < 1, a size on an entity that does not exist, ...).
+/// hgrad < 1, a size on an entity that does not exist, ...). A size on a
+/// region costs one Model::classify_point per octree corner and centre in
+/// the region's box, per refinement round.
 SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& options);
 
 }  // namespace cm::size

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <unordered_map>
 
 #include <tbb/parallel_for.h>
@@ -297,44 +298,65 @@ std::vector<SizeSample> sample_face_proximity(const geom::Model& model, int face
   return out;
 }
 
+namespace {
+
+// Grid points of a face's parameter box on the trimmed face, spacing <= h/2
+// in 3D along each direction (the face's boundary is its edges' business).
+void sample_face_interior(const geom::Model& model, int face, int cap,
+                          const std::function<void(const Vec3&, geom::EntityRef, const Vec2&)>& add, double h) {
+  const geom::ParamRange pr = model.param_range({2, face});
+  const int nu = cells_for(face_extent(model, face, pr, true), 0.5 * h, 1, cap);
+  const int nv = cells_for(face_extent(model, face, pr, false), 0.5 * h, 1, cap);
+  for (int i = 0; i <= nu; ++i)
+    for (int j = 0; j <= nv; ++j) {
+      const Vec2 uv(pr.u0 + (pr.u1 - pr.u0) * i / nu, pr.v0 + (pr.v1 - pr.v0) * j / nv);
+      if (model.contains_param(face, uv)) add(model.face_point(face, uv), {2, face}, uv);
+    }
+}
+
+void sample_edge(const geom::Model& model, int edge, int cap,
+                 const std::function<void(const Vec3&, geom::EntityRef, const Vec2&)>& add, double h) {
+  const geom::ParamRange pr = model.param_range({1, edge});
+  const int n = cells_for(model.length(edge), 0.5 * h, 1, cap);
+  for (int i = 0; i <= n; ++i) {
+    const double u = pr.u0 + (pr.u1 - pr.u0) * i / n;
+    add(model.edge_point(edge, u), {1, edge}, Vec2(u, 0));
+  }
+}
+
+}  // namespace
+
 std::vector<SizeSample> sample_entity_size(const geom::Model& model, geom::EntityRef e, double h,
                                            int max_points_per_direction) {
   if (!(h > 0) || !std::isfinite(h)) throw std::invalid_argument("entity size must be finite and > 0");
   std::vector<SizeSample> out;
-  const auto add = [&](const Vec3& x, geom::EntityRef on, const Vec2& uv) {
+  const std::function<void(const Vec3&, geom::EntityRef, const Vec2&)> add = [&](const Vec3& x, geom::EntityRef on,
+                                                                                   const Vec2& uv) {
     out.push_back({x, h, SizeSource::kEntitySize, on, uv, 0, 0, Vec3::Zero()});
   };
   const int cap = std::max(1, max_points_per_direction);
+  // The faces to cover, and the edges that bound them, each once: a region's
+  // faces share their edges, and a seam or an internal face is used twice.
+  std::vector<int> faces, edges;
   switch (e.dim) {
-    case 0: add(model.vertex_point(e.tag), e, Vec2::Zero()); break;
-    case 1: {
-      const geom::ParamRange pr = model.param_range(e);
-      const int n = cells_for(model.length(e.tag), 0.5 * h, 1, cap);
-      for (int i = 0; i <= n; ++i) {
-        const double u = pr.u0 + (pr.u1 - pr.u0) * i / n;
-        add(model.edge_point(e.tag, u), e, Vec2(u, 0));
-      }
+    case 0: add(model.vertex_point(e.tag), e, Vec2::Zero()); return out;
+    case 1: sample_edge(model, e.tag, cap, add, h); return out;
+    case 2: faces.push_back(e.tag); break;
+    case 3:
+      for (const geom::OrientedUse& use : model.region_faces(e.tag)) faces.push_back(use.tag);
       break;
-    }
-    case 2: {
-      for (const geom::Loop& loop : model.face_loops(e.tag))
-        for (const geom::OrientedUse& use : loop.edges) {
-          auto edge_samples = sample_entity_size(model, {1, use.tag}, h, max_points_per_direction);
-          out.insert(out.end(), edge_samples.begin(), edge_samples.end());
-        }
-      const geom::ParamRange pr = model.param_range(e);
-      const int nu = cells_for(face_extent(model, e.tag, pr, true), 0.5 * h, 1, cap);
-      const int nv = cells_for(face_extent(model, e.tag, pr, false), 0.5 * h, 1, cap);
-      for (int i = 0; i <= nu; ++i)
-        for (int j = 0; j <= nv; ++j) {
-          const Vec2 uv(pr.u0 + (pr.u1 - pr.u0) * i / nu, pr.v0 + (pr.v1 - pr.v0) * j / nv);
-          if (model.contains_param(e.tag, uv)) add(model.face_point(e.tag, uv), e, uv);
-        }
-      break;
-    }
     default:
-      throw std::invalid_argument("a size can be given on a vertex, an edge or a face (dimension 0-2)");
+      throw std::invalid_argument("a size can be given on a vertex, an edge, a face or a region (dimension 0-3)");
   }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  for (const int f : faces)
+    for (const geom::Loop& loop : model.face_loops(f))
+      for (const geom::OrientedUse& use : loop.edges) edges.push_back(use.tag);
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const int edge : edges) sample_edge(model, edge, cap, add, h);
+  for (const int f : faces) sample_face_interior(model, f, cap, add, h);
   return out;
 }
 

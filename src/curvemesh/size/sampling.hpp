@@ -79,8 +79,11 @@ std::vector<SizeSample> sample_model_curvature(const geom::Model& model, const S
 /// nearly parallel edges gets elements as small as it is wide).
 std::vector<SizeSample> sample_face_proximity(const geom::Model& model, int face, double hmin, double hmax);
 
-/// Points covering a vertex, edge or face (spacing <= h/2, at most
-/// max_points_per_direction per parameter direction), each with size h.
+/// Points covering a vertex, edge or face, or the boundary of a region (its
+/// faces and their edges), with spacing <= h/2 and at most
+/// max_points_per_direction per parameter direction, each with size h and
+/// the vertex, edge or face it lies on. A region's interior is not sampled:
+/// build_size_field covers it with a field (see build.hpp).
 std::vector<SizeSample> sample_entity_size(const geom::Model& model, geom::EntityRef entity, double h,
                                            int max_points_per_direction = 1024);
 

@@ -11,7 +11,12 @@
 // GeomEvaluator_* holding Geom handles, equally read-only. No query constructs
 // or touches a shared adaptor. The one shared OCC object with hidden mutable
 // state is the trimmed-face classifier, which is locked per face (see
-// FaceData::classifier); results never depend on which thread asks, so
+// FaceData::classifier); the solid classifiers of classify_point are worse
+// (every Perform mutates them) and are lent out one per caller from a
+// per-region pool (RegionData::classifiers), behind a tessellation that
+// answers for points away from the boundary (RegionMesh, built on first use
+// from a copy of the solid, so the model's faces never get a triangulation
+// attached). Results never depend on which thread asks, so
 // answers are bitwise the same serially and in parallel. Handle reference
 // counts are atomic in OCCT. Mass properties are computed once on first use
 // (Lazy, std::call_once).
@@ -26,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include <BRepClass3d_SolidClassifier.hxx>
 #include <BRepTopAdaptor_FClass2d.hxx>
 #include <Geom2d_Curve.hxx>
 #include <Geom_Curve.hxx>
@@ -37,6 +43,7 @@
 #include <TopTools_IndexedMapOfShape.hxx>
 
 #include "curvemesh/geom/model.hpp"
+#include "curvemesh/geom_occ/detail/triangle_classifier.hpp"
 
 namespace cm::geom_occ::detail {
 
@@ -125,11 +132,34 @@ struct FaceData {
   double uv_loop_gap = 0;
 };
 
+/// Solid classifiers of one region, for classify_point. Perform is not
+/// const in any sense: the solid explorer inside moves member iterators over
+/// the shells and faces and caches one curve-surface intersector per face.
+/// So a classifier serves one caller at a time; building one is the costly
+/// part (those intersectors), so idle ones are kept for the next caller.
+/// The pool grows to the number of concurrent callers and no further.
+struct ClassifierPool {
+  std::mutex mutex;
+  std::vector<std::unique_ptr<BRepClass3d_SolidClassifier>> idle;
+};
+
+/// The fast paths of classify_point (occ_classify.cpp): the region's
+/// boundary tessellated, each triangle with the band around it inside which
+/// the tessellation's side of a point may differ from the solid's (its
+/// measured deviation from its face, doubled, plus the tolerances). Null
+/// surface: no usable tessellation, every point goes to the exact classifier.
+struct RegionMesh {
+  std::unique_ptr<TriangleClassifier> surface;
+  double band = 0;       ///< the widest triangle band
+  double tolerance = 0;  ///< largest tolerance of the region's faces, edges and vertices
+};
+
 struct RegionData {
   TopoDS_Solid solid;
   std::vector<geom::OrientedUse> faces;
   double tolerance = 0;
   geom::BoundingBox box;  // union of its faces' boxes
+  std::unique_ptr<ClassifierPool> classifiers = std::make_unique<ClassifierPool>();
 };
 
 /// contains_param on a face's data (occ_queries.cpp).
@@ -172,6 +202,7 @@ class OccModel final : public geom::Model {
                                  std::optional<Vec2> hint = {}) const override;
   Vec2 edge_param_on_face(int edge, int face, double u, bool forward = true) const override;
   bool contains_param(int face, const Vec2& uv) const override;
+  geom::Containment classify_point(int region, const Vec3& x) const override;
 
   double area(int face) const override;
   double length(int edge) const override;
@@ -201,12 +232,18 @@ class OccModel final : public geom::Model {
                                             const Vec2& near_uv) const;
   static Vec2 pcurve_point(const PCurveUse& use, double u);
 
+  // Point in solid (occ_classify.cpp).
+  RegionMesh build_region_mesh(int region) const;
+  std::optional<geom::Containment> classify_near_faces(const RegionData& region, const RegionMesh& mesh,
+                                                       const Vec3& x) const;
+
   std::vector<VertexData> vertices_;
   std::vector<EdgeData> edges_;
   std::vector<FaceData> faces_;
   std::vector<RegionData> regions_;
   std::unique_ptr<Lazy<double>[]> face_areas_;
   std::unique_ptr<Lazy<MassProperties>[]> region_mass_;
+  std::unique_ptr<Lazy<RegionMesh>[]> region_meshes_;
   geom::BoundingBox box_;
   double scale_ = 1;  // model bounding-box diagonal: the length scale of iteration tolerances
   std::string units_;
