@@ -34,18 +34,37 @@ struct MeshCliOptions {
   bool no_optimize = false;
 };
 
+// The model and its size field, loaded the same way for both dimensions.
+struct Inputs {
+  size::SizeOptions size_options;
+  std::unique_ptr<geom::Model> model;
+  size::SizeFieldResult size;
+  double load_seconds = 0, size_seconds = 0;
+};
+
+Inputs load_inputs(const MeshCliOptions& o) {
+  Inputs in;
+  Timer step;
+  in.size_options = make_size_options(o.size);
+  in.model = geom_occ::load_model(o.model, o.model_flags.load_options());
+  in.load_seconds = step.seconds();
+  step.reset();
+  in.size = size::build_size_field(*in.model, in.size_options);
+  in.size_seconds = step.seconds();
+  return in;
+}
+
 int run_volume(const MeshCliOptions& o);
 
 int run_mesh(const MeshCliOptions& o) {
   if (o.dim == 3) return run_volume(o);
   Timer total;
   Timer step;
-  const size::SizeOptions so = make_size_options(o.size);
-  const auto model = geom_occ::load_model(o.model, o.model_flags.load_options());
-  const double load_s = step.seconds();
-  step.reset();
-  const size::SizeFieldResult sf = size::build_size_field(*model, so);
-  const double size_s = step.seconds();
+  const Inputs in = load_inputs(o);
+  const size::SizeOptions& so = in.size_options;
+  const geom::Model* model = in.model.get();
+  const size::SizeFieldResult& sf = in.size;
+  const double load_s = in.load_seconds, size_s = in.size_seconds;
   generate::BoundaryMeshStats st;
   const mesh::TetMesh m = generate::mesh_boundary(*model, *sf.field, {}, &st);
   step.reset();
@@ -120,12 +139,11 @@ std::pair<double, double> volumes(const geom::Model& model, const mesh::TetMesh&
 int run_volume(const MeshCliOptions& o) {
   Timer total;
   Timer step;
-  const size::SizeOptions so = make_size_options(o.size);
-  const auto model = geom_occ::load_model(o.model, o.model_flags.load_options());
-  const double load_s = step.seconds();
-  step.reset();
-  const size::SizeFieldResult sf = size::build_size_field(*model, so);
-  const double size_s = step.seconds();
+  const Inputs in = load_inputs(o);
+  const size::SizeOptions& so = in.size_options;
+  const geom::Model* model = in.model.get();
+  const size::SizeFieldResult& sf = in.size;
+  const double load_s = in.load_seconds, size_s = in.size_seconds;
   generate::VolumeMeshStats st;
   mesh::TetMesh m = generate::mesh_volume(*model, *sf.field, {}, &st);
   optimize::ImproveStats opt;
