@@ -87,6 +87,7 @@ int run_mesh(const MeshCliOptions& o) {
                 {"vertices_off_entity", rep.vertices_off_entity},
                 {"max_vertex_distance_over_tolerance", rep.max_vertex_distance},
                 {"folded_triangles", rep.folded_triangles},
+                {"crossing_triangle_pairs", rep.crossing_pairs},
                 {"open_region_edges", rep.open_region_edges},
                 {"unmeshed_faces", rep.unmeshed_faces},
                 {"problems", rep.problems}};
@@ -116,8 +117,10 @@ int run_mesh(const MeshCliOptions& o) {
     fmt::print("sizes: {:.1f}% of edges within [0.7, 1.4] of the requested size\n", pct_size);
     fmt::print("check: {}", rep.valid() ? "valid" : "INVALID");
     if (!rep.valid())
-      fmt::print(" ({} vertices off their entity, {} folded triangles, {} open region edges, {} unmeshed faces)",
-                 rep.vertices_off_entity, rep.folded_triangles, rep.open_region_edges, rep.unmeshed_faces);
+      fmt::print(" ({} vertices off their entity, {} folded triangles, {} crossing triangle pairs, {} open region "
+                 "edges, {} unmeshed faces)",
+                 rep.vertices_off_entity, rep.folded_triangles, rep.crossing_pairs, rep.open_region_edges,
+                 rep.unmeshed_faces);
     fmt::print("\n");
     for (const auto& p : rep.problems) fmt::print("  {}\n", p);
     fmt::print("time: load {:.2f} s, size field {:.2f} s, edges {:.2f} s, faces {:.2f} s, check {:.2f} s, "
@@ -184,6 +187,7 @@ int run_volume(const MeshCliOptions& o) {
                    {"missing_triangles", st.recovery.missing_triangles_initial},
                    {"steiner_on_model_edges", st.recovery.steiner_on_edges},
                    {"steiner_on_model_faces", st.recovery.steiner_on_faces},
+                   {"surface_flips", st.recovery.surface_flips},
                    {"rounds", st.recovery.rounds},
                    {"region_conflicts", st.region_conflicts}};
   j["check"] = {{"valid", ok},
@@ -225,9 +229,10 @@ int run_volume(const MeshCliOptions& o) {
     fmt::print("mesh: {} vertices, {} tets, {} boundary triangles; {} interior points ({} refused)\n",
                m.num_verts(), nt, m.tris.size(), st.interior_points, st.refused_points);
     fmt::print("recovery: {} missing edges, {} missing triangles; {} Steiner points ({} on model edges, {} on model "
-               "faces) in {} rounds\n",
+               "faces), {} surface flips, in {} rounds\n",
                st.recovery.missing_edges_initial, st.recovery.missing_triangles_initial, steiner,
-               st.recovery.steiner_on_edges, st.recovery.steiner_on_faces, st.recovery.rounds);
+               st.recovery.steiner_on_edges, st.recovery.steiner_on_faces, st.recovery.surface_flips,
+               st.recovery.rounds);
     if (!o.no_optimize)
       fmt::print("optimization: {} edge removals, {} face swaps, {} relocations in {} passes; tets with mean ratio "
                  "< 0.3: {} -> {}; min {:.3f} -> {:.3f}\n",

@@ -1,4 +1,5 @@
 #include "curvemesh/generate/boundary_check.hpp"
+#include "curvemesh/generate/surface_intersection.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -82,6 +83,10 @@ BoundaryReport check_boundary(const geom::Model& model, const mesh::TetMesh& m, 
     }
   });
   r.folded_triangles = folded;
+  const auto crossing = crossing_triangles(m.coords, m.tris);
+  r.crossing_pairs = crossing.size();
+  for (const auto& [i, j] : crossing)
+    problem(fmt::format("triangles {} (face {}) and {} (face {}) cross", i, m.tris[i].face_tag, j, m.tris[j].face_tag));
   r.poor_triangles = poor;
   r.poor_at_sharp_corners = poor_sharp;
   r.poor_at_small_features = poor_small;

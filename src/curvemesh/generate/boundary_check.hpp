@@ -16,6 +16,7 @@ struct BoundaryReport {
   double max_vertex_distance = 0;   ///< from a vertex to its entity at its parameters, relative to tolerance
   std::size_t vertices_off_entity = 0;
   std::size_t folded_triangles = 0; ///< normal against the surface normal at the centroid
+  std::size_t crossing_pairs = 0;   ///< pairs of triangles that cross each other (crossing_triangles)
   // Topological compatibility.
   std::size_t open_region_edges = 0;     ///< region boundary edges not used exactly twice, oppositely
   std::size_t unmeshed_faces = 0;
@@ -31,7 +32,7 @@ struct BoundaryReport {
   std::size_t poor_at_small_features = 0;
   std::vector<std::string> problems;    ///< first few failures, human-readable
 
-  bool valid() const { return vertices_off_entity == 0 && folded_triangles == 0 && open_region_edges == 0 && unmeshed_faces == 0; }
+  bool valid() const { return vertices_off_entity == 0 && folded_triangles == 0 && crossing_pairs == 0 && open_region_edges == 0 && unmeshed_faces == 0; }
 };
 
 BoundaryReport check_boundary(const geom::Model& model, const mesh::TetMesh& mesh, const size::SizeField& size);

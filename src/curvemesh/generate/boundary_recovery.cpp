@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
 #include <fmt/format.h>
 
 #include "curvemesh/core/error.hpp"
+#include "curvemesh/generate/surface_intersection.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 
 namespace cm::generate {
@@ -128,6 +130,57 @@ class Surface {
     return p;
   }
 
+  /// Flips surface edge (a, b) to (c, d), the other diagonal of its two
+  /// triangles, when that diagonal is an edge of the tetrahedralization and
+  /// the flip is valid on the surface. Only edges inside one model face are
+  /// flipped: they are not constraints of the model, any triangulation of the
+  /// face's points will do, and the one the 3D Delaunay mesh already contains
+  /// costs no Steiner point. Splitting such edges instead bisects triangles
+  /// towards their opposite vertex, which shrinks their angles; in a face
+  /// tapering to a sharp tip that cascades without end. Returns false when
+  /// the flip does not apply.
+  bool flip_to_mesh(VertId a, VertId b, std::vector<TetId>& scratch) {
+    const std::uint64_t key = edge_key(a, b);
+    if (segment_of_.count(key)) return false;
+    const auto it = tris_of_.find(key);
+    if (it == tris_of_.end() || it->second.size() != 2) return false;
+    const std::uint32_t t1 = it->second[0], t2 = it->second[1];
+    if (m_.tris[t1].face_tag != m_.tris[t2].face_tag) return false;
+    // Read t1 as (a, b, c): then a consistently oriented t2 is (b, a, d).
+    auto rotate_to = [&](std::uint32_t t, VertId x, VertId y) -> std::optional<VertId> {
+      const auto& v = m_.tris[t].verts;
+      for (int k = 0; k < 3; ++k)
+        if (v[k] == x && v[(k + 1) % 3] == y) return v[(k + 2) % 3];
+      return {};
+    };
+    auto c = rotate_to(t1, a, b);
+    std::uint32_t ta = t1, tb = t2;
+    if (!c) {
+      std::swap(ta, tb);
+      c = rotate_to(ta, a, b);
+    }
+    const auto d = rotate_to(tb, b, a);
+    if (!c || !d || *c == *d) return false;
+    if (tris_of_.count(edge_key(*c, *d)) || segment_of_.count(edge_key(*c, *d))) return false;
+    if (!has_edge(m_, *c, *d, scratch)) return false;
+    // Valid on the surface: both new triangles face the way the old pair
+    // does (the quad is convex seen along its normal, nothing folds).
+    const auto& x = m_.coords;
+    const Vec3 n = (x[b] - x[a]).cross(x[*c] - x[a]) + (x[a] - x[b]).cross(x[*d] - x[b]);
+    const Vec3 n1 = (x[*d] - x[a]).cross(x[*c] - x[a]), n2 = (x[*c] - x[b]).cross(x[*d] - x[b]);
+    if (!(n1.dot(n) > 0 && n2.dot(n) > 0)) return false;
+    m_.tris[ta].verts = {a, *d, *c};
+    m_.tris[tb].verts = {b, *c, *d};
+    tris_of_.erase(it);
+    tris_of_[edge_key(*c, *d)] = {ta, tb};
+    // (b, c) moved from ta to tb and (a, d) from tb to ta.
+    for (auto& id : tris_of_[edge_key(b, *c)])
+      if (id == ta) id = tb;
+    for (auto& id : tris_of_[edge_key(a, *d)])
+      if (id == tb) id = ta;
+    return true;
+  }
+
  private:
   /// Parameter of vertex v on model edge e: its own u, or the end of e it
   /// sits at (for a closed edge, the end nearer `near`).
@@ -177,7 +230,57 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   for (VertId v = 0; v < m.coords.size(); ++v) surface_verts += m.vert_class[v].dim >= 0 && m.vert_class[v].dim <= 2;
   const auto max_steiner = static_cast<std::size_t>(o.max_steiner_factor * static_cast<double>(surface_verts)) + 1000;
   std::vector<std::pair<VertId, VertId>> to_split;
+  std::vector<TetId> ball;
   int last_face = 0;
+  auto split_and_insert = [&](VertId a, VertId b) {
+    const VertId p = surf.split(a, b, st);
+    const auto r = dt.insert(p, m.vert2tet[a]);
+    if (r.refusal != modify::Refusal::kNone)
+      throw GeometryError(fmt::format("face {}: Steiner point {} could not be inserted ({})", last_face, p,
+                                      modify::to_string(r.refusal)));
+  };
+  // Crossing triangles first: no tetrahedralization contains both, and
+  // splitting them only where they are missing would never end. They come
+  // from triangles coarser than a thin feature (two faces closer than the
+  // chord error); splitting their longest edges on the model brings the
+  // mesh to the surfaces, which do not cross, so a few rounds end it.
+  for (int round = 0;; ++round) {
+    const auto pairs = crossing_triangles(m.coords, m.tris);
+    if (round == 0) st.crossing_pairs_initial = pairs.size();
+    if (pairs.empty()) break;
+    if (round >= 30) {
+      const auto& t = m.tris[pairs.front()[0]];
+      const auto& u = m.tris[pairs.front()[1]];
+      const Vec3 x = m.coords[t.verts[0]];
+      throw GeometryError(fmt::format("faces {} and {}: the surface mesh still crosses itself near ({:.6g} {:.6g} "
+                                      "{:.6g}) after {} rounds of refinement ({} crossing pairs); do the model's "
+                                      "faces intersect?",
+                                      t.face_tag, u.face_tag, x.x(), x.y(), x.z(), round, pairs.size()));
+    }
+    std::vector<std::pair<VertId, VertId>> longest;
+    for (const auto& pair : pairs)
+      for (std::uint32_t i : pair) {
+        const auto& v = m.tris[i].verts;
+        int e = 0;
+        double best = -1;
+        for (int k = 0; k < 3; ++k) {
+          const double l = (m.coords[v[k]] - m.coords[v[(k + 1) % 3]]).squaredNorm();
+          if (l > best) {
+            best = l;
+            e = k;
+          }
+        }
+        longest.emplace_back(std::min(v[e], v[(e + 1) % 3]), std::max(v[e], v[(e + 1) % 3]));
+      }
+    std::sort(longest.begin(), longest.end());
+    longest.erase(std::unique(longest.begin(), longest.end()), longest.end());
+    for (const auto& [a, b] : longest) {
+      if (!surf.exists(a, b)) continue;
+      last_face = m.tris[pairs.front()[0]].face_tag;
+      split_and_insert(a, b);
+      ++st.crossing_splits;
+    }
+  }
   // After the first round only simplices touching a vertex of a new tet can
   // have changed: every missing one was split, every other one that vanished
   // lost it to a cavity, whose vertices all lie in the new tets.
@@ -257,6 +360,27 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
       st.missing_triangles_initial = missing_tris;
     }
     if (to_split.empty()) return st;
+    // Surface flips first: a flipped edge needs no Steiner point. Vertices
+    // of flipped triangles are checked again next round (no tet changed, so
+    // the rebuild hook did not mark them).
+    std::size_t flipped = 0;
+    std::erase_if(to_split, [&](const std::pair<VertId, VertId>& e) {
+      const auto [a, b] = e;
+      if (!surf.exists(a, b)) return false;
+      const auto it = surf.edges().find(edge_key(a, b));
+      std::array<VertId, 4> quad{a, b, kNone, kNone};
+      if (it != surf.edges().end() && it->second.size() == 2)
+        for (int k = 0; k < 2; ++k)
+          for (VertId v : m.tris[it->second[k]].verts)
+            if (v != a && v != b) quad[2 + k] = v;
+      if (!surf.flip_to_mesh(a, b, ball)) return false;
+      if (dirty.size() < m.coords.size()) dirty.resize(m.coords.size(), 0);
+      for (VertId v : quad) dirty[v] = 1;
+      ++flipped;
+      return true;
+    });
+    st.surface_flips += flipped;
+    if (to_split.empty()) continue;
     if (st.rounds >= o.max_rounds || st.steiner_on_edges + st.steiner_on_faces > max_steiner) {
       const auto [a, b] = to_split.front();
       const Vec3 x = m.coords[a], y = m.coords[b];
@@ -272,11 +396,7 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
       // A cascade (surfaces meeting at a tiny angle or nearly touching) can
       // multiply the splits of one round: stop as soon as the budget is spent.
       if (st.steiner_on_edges + st.steiner_on_faces > max_steiner) break;
-      const VertId p = surf.split(a, b, st);
-      const auto r = dt.insert(p, m.vert2tet[a]);
-      if (r.refusal != modify::Refusal::kNone)
-        throw GeometryError(fmt::format("face {}: Steiner point {} could not be inserted ({})", last_face, p,
-                                        modify::to_string(r.refusal)));
+      split_and_insert(a, b);
     }
   }
 }

@@ -3,11 +3,17 @@
 // edge and triangle of the classified surface mesh an edge and a face of the
 // Delaunay tetrahedralization of its points.
 //
+// First, triangles that cross each other (a surface mesh coarser than a thin
+// feature) have their longest edges split on the model until none cross:
+// nothing else could recover them.
+//
 // Method: conforming recovery by Steiner points on the model. A missing mesh
 // edge is split at the point of its model entity closest to its midpoint — on
 // the model edge (parameter kept) when it is a model-edge segment, else on the
 // model face ((u, v) kept) — the triangles around it are split too, and the
-// point is inserted in the Delaunay mesh. A missing triangle whose edges are
+// point is inserted in the Delaunay mesh. A missing edge inside one model face
+// is first flipped in the surface mesh when the other diagonal of its two
+// triangles is a mesh edge (the face's points can be triangulated either way). A missing triangle whose edges are
 // all present has its longest edge split. Splits shrink the local spacing
 // until every surface simplex is Delaunay; since points are only added on the
 // model, geometric similarity holds throughout. The loop is bounded: if it has
@@ -29,6 +35,9 @@ struct RecoveryOptions {
 struct RecoveryStats {
   std::size_t missing_edges_initial = 0, missing_triangles_initial = 0;
   std::size_t steiner_on_edges = 0, steiner_on_faces = 0;
+  std::size_t surface_flips = 0;
+  std::size_t crossing_pairs_initial = 0;  ///< pairs of surface triangles crossing each other before recovery
+  std::size_t crossing_splits = 0;         ///< Steiner points (counted above too) that removed crossings  ///< face-interior surface edges flipped to an edge of the tetrahedralization
   int rounds = 0;
 };
 

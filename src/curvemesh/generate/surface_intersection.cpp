@@ -1,0 +1,121 @@
+#include "curvemesh/generate/surface_intersection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "curvemesh/core/predicates.hpp"
+
+namespace cm::generate {
+
+namespace {
+
+using predicates::orient3d;
+
+// Segment (d, e) meets the closed triangle (a, b, c) at a point strictly
+// between d and e. Non-coplanar only: a segment in the triangle's plane is
+// left to the other triangle's edges.
+bool segment_crosses(const Vec3& d, const Vec3& e, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const int sd = orient3d(a.data(), b.data(), c.data(), d.data());
+  const int se = orient3d(a.data(), b.data(), c.data(), e.data());
+  if (sd == 0 || se == 0 || sd == se) return false;
+  const int t1 = orient3d(d.data(), e.data(), a.data(), b.data());
+  const int t2 = orient3d(d.data(), e.data(), b.data(), c.data());
+  const int t3 = orient3d(d.data(), e.data(), c.data(), a.data());
+  return (t1 >= 0 && t2 >= 0 && t3 >= 0) || (t1 <= 0 && t2 <= 0 && t3 <= 0);
+}
+
+bool cross(std::span<const Vec3> x, const std::array<VertId, 3>& p, const std::array<VertId, 3>& q) {
+  int shared = 0, sp = -1, sq = -1;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (p[i] == q[j]) {
+        ++shared;
+        sp = i;
+        sq = j;
+      }
+  if (shared >= 2) return false;
+  auto edge_hits = [&](const std::array<VertId, 3>& s, int i, const std::array<VertId, 3>& t) {
+    return segment_crosses(x[s[i]], x[s[(i + 1) % 3]], x[t[0]], x[t[1]], x[t[2]]);
+  };
+  if (shared == 1) return edge_hits(p, (sp + 1) % 3, q) || edge_hits(q, (sq + 1) % 3, p);
+  for (int i = 0; i < 3; ++i)
+    if (edge_hits(p, i, q) || edge_hits(q, i, p)) return true;
+  return false;
+}
+
+}  // namespace
+
+std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec3> x,
+                                                             std::span<const mesh::ClassifiedTri> tris) {
+  std::vector<std::array<std::uint32_t, 2>> out;
+  const std::size_t n = tris.size();
+  if (n < 2) return out;
+  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+  double extent = 0;
+  for (const auto& t : tris) {
+    Vec3 tl = x[t.verts[0]], th = tl;
+    for (VertId v : t.verts) {
+      tl = tl.cwiseMin(x[v]);
+      th = th.cwiseMax(x[v]);
+    }
+    lo = lo.cwiseMin(tl);
+    hi = hi.cwiseMax(th);
+    extent += (th - tl).maxCoeff();
+  }
+  // Cells about the size of a mean triangle: each triangle overlaps a few
+  // cells and each cell holds a few triangles. Capped so the grid stays
+  // proportional to the mesh even for very uneven sizes.
+  const Vec3 span = (hi - lo).cwiseMax(1e-300);
+  double cell = std::max(extent / static_cast<double>(n), 1e-300);
+  const double max_cells = 8.0 * static_cast<double>(n);
+  while ((span / cell).array().ceil().prod() > max_cells) cell *= 1.5;
+  const auto dims = ((span / cell).array().floor() + 1).cast<std::int64_t>().eval();
+  auto cell_of = [&](const Vec3& p) {
+    Eigen::Array<std::int64_t, 3, 1> c = ((p - lo) / cell).array().floor().cast<std::int64_t>();
+    return c.min(dims - 1).max(0).eval();
+  };
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
+  entries.reserve(4 * n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const auto& v = tris[i].verts;
+    const Vec3 tl = x[v[0]].cwiseMin(x[v[1]]).cwiseMin(x[v[2]]), th = x[v[0]].cwiseMax(x[v[1]]).cwiseMax(x[v[2]]);
+    const auto c0 = cell_of(tl), c1 = cell_of(th);
+    for (auto i0 = c0[0]; i0 <= c1[0]; ++i0)
+      for (auto i1 = c0[1]; i1 <= c1[1]; ++i1)
+        for (auto i2 = c0[2]; i2 <= c1[2]; ++i2)
+          entries.emplace_back(static_cast<std::uint64_t>((i2 * dims[1] + i1) * dims[0] + i0), i);
+  }
+  std::sort(entries.begin(), entries.end());
+  // A pair sharing several cells is tested once: stamp the partners already
+  // tested against triangle i.
+  std::vector<std::uint32_t> tested(n, UINT32_MAX);
+  std::vector<std::vector<std::uint32_t>> partners(n);
+  for (std::size_t b = 0; b < entries.size();) {
+    std::size_t e = b;
+    while (e < entries.size() && entries[e].first == entries[b].first) ++e;
+    for (std::size_t i = b; i < e; ++i)
+      for (std::size_t j = i + 1; j < e; ++j) partners[entries[i].second].push_back(entries[j].second);
+    b = e;
+  }
+  auto box_overlap = [&](std::uint32_t i, std::uint32_t j) {
+    const auto &p = tris[i].verts, &q = tris[j].verts;
+    const Vec3 pl = x[p[0]].cwiseMin(x[p[1]]).cwiseMin(x[p[2]]), ph = x[p[0]].cwiseMax(x[p[1]]).cwiseMax(x[p[2]]);
+    const Vec3 ql = x[q[0]].cwiseMin(x[q[1]]).cwiseMin(x[q[2]]), qh = x[q[0]].cwiseMax(x[q[1]]).cwiseMax(x[q[2]]);
+    return (pl.array() <= qh.array()).all() && (ql.array() <= ph.array()).all();
+  };
+  for (std::uint32_t i = 0; i < n; ++i) {
+    for (std::uint32_t j : partners[i]) {
+      const std::uint32_t a = std::min(i, j), b = std::max(i, j);
+      if (a == b || tested[b] == a) continue;
+      tested[b] = a;
+      if (!box_overlap(a, b)) continue;
+      if (cross(x, tris[a].verts, tris[b].verts)) out.push_back({a, b});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+}  // namespace cm::generate
