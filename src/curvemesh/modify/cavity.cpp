@@ -38,6 +38,8 @@ std::string_view to_string(Refusal r) {
     case Refusal::kDuplicatePoint: return "duplicate point";
     case Refusal::kOutsideDomain: return "outside the domain";
     case Refusal::kTooClose: return "too close to a vertex";
+    case Refusal::kFoldedSurface: return "folded boundary surface";
+    case Refusal::kNonManifold: return "non-manifold";
   }
   return "?";
 }

@@ -31,6 +31,8 @@ enum class Refusal : std::uint8_t {
   kDuplicatePoint,    ///< the point coincides with an existing vertex
   kOutsideDomain,     ///< the point is not inside the meshed domain
   kTooClose,          ///< the point is closer than allowed to a vertex
+  kFoldedSurface,     ///< a boundary triangle would flip (or fold against its model face)
+  kNonManifold,       ///< would duplicate a triangle or edge, or pinch the mesh (link condition)
 };
 std::string_view to_string(Refusal r);
 
