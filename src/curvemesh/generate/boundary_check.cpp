@@ -83,7 +83,9 @@ BoundaryReport check_boundary(const geom::Model& model, const mesh::TetMesh& m, 
     }
   });
   r.folded_triangles = folded;
-  const auto crossing = crossing_triangles(m.coords, m.tris);
+  std::vector<char> planar(static_cast<std::size_t>(model.count(2)) + 1, 0);
+  for (int f = 1; f <= model.count(2); ++f) planar[f] = model.type({2, f}) == geom::ShapeType::kPlane;
+  const auto crossing = crossing_triangles(m.coords, m.tris, planar);
   r.crossing_pairs = crossing.size();
   for (const auto& [i, j] : crossing)
     problem(fmt::format("triangles {} (face {}) and {} (face {}) cross", i, m.tris[i].face_tag, j, m.tris[j].face_tag));

@@ -244,8 +244,10 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   // from triangles coarser than a thin feature (two faces closer than the
   // chord error); splitting their longest edges on the model brings the
   // mesh to the surfaces, which do not cross, so a few rounds end it.
+  std::vector<char> planar(static_cast<std::size_t>(model.count(2)) + 1, 0);
+  for (int f = 1; f <= model.count(2); ++f) planar[f] = model.type({2, f}) == geom::ShapeType::kPlane;
   for (int round = 0;; ++round) {
-    const auto pairs = crossing_triangles(m.coords, m.tris);
+    const auto pairs = crossing_triangles(m.coords, m.tris, planar);
     if (round == 0) st.crossing_pairs_initial = pairs.size();
     if (pairs.empty()) break;
     if (round >= 30) {

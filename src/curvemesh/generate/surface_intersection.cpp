@@ -47,7 +47,8 @@ bool cross(std::span<const Vec3> x, const std::array<VertId, 3>& p, const std::a
 }  // namespace
 
 std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec3> x,
-                                                             std::span<const mesh::ClassifiedTri> tris) {
+                                                             std::span<const mesh::ClassifiedTri> tris,
+                                                             std::span<const char> planar) {
   std::vector<std::array<std::uint32_t, 2>> out;
   const std::size_t n = tris.size();
   if (n < 2) return out;
@@ -110,6 +111,8 @@ std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec
       if (a == b || tested[b] == a) continue;
       tested[b] = a;
       if (!box_overlap(a, b)) continue;
+      const auto f = tris[a].face_tag;
+      if (f == tris[b].face_tag && f >= 0 && static_cast<std::size_t>(f) < planar.size() && planar[f]) continue;
       if (cross(x, tris[a].verts, tris[b].verts)) out.push_back({a, b});
     }
   }

@@ -22,7 +22,12 @@ namespace cm::generate {
 /// catches); triangles sharing one vertex are compared on the edges opposite
 /// to it. Touching without crossing (exact zeros) is not reported. Broad phase
 /// by a uniform grid of the triangles' boxes: O(n) for a well-spread mesh.
+/// Pairs of triangles of one face f with `planar[f] != 0` are not compared:
+/// a planar face meshed without overlap in its parameter plane cannot cross
+/// itself, and its coplanar pairs are the costly case of the exact test
+/// (every orientation is an exact zero).
 std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec3> coords,
-                                                             std::span<const mesh::ClassifiedTri> tris);
+                                                             std::span<const mesh::ClassifiedTri> tris,
+                                                             std::span<const char> planar = {});
 
 }  // namespace cm::generate
