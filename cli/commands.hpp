@@ -21,5 +21,7 @@ void add_size_command(CLI::App& app, Runner& runner);
 void add_mesh_command(CLI::App& app, Runner& runner);
 /// `curvemesh convert IN OUT`
 void add_convert_command(CLI::App& app, Runner& runner);
+/// `curvemesh optimize IN -o OUT [--sol S] [--aniso]`
+void add_optimize_command(CLI::App& app, Runner& runner);
 
 }  // namespace cm::cli

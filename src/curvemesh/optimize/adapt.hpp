@@ -1,0 +1,86 @@
+#pragma once
+// Optimization with a size specification (paper 2, second and third cases):
+// shapes and lengths measured in a metric field carried by the vertices
+// (metric_field.hpp). An isotropic size map leaves the shape measure as it
+// is (a constant I/h² does not change shape) and only asks for unit lengths;
+// an anisotropic metric changes both.
+//
+// Each pass, as MMG does it: split the edges longer than 1.4 in the metric
+// (longest first), collapse those shorter than 0.7 (shortest first, only
+// when no edge of the result is longer than 1.4, so the two never undo each
+// other), then improve the tets whose quality in the metric is below the
+// threshold: the best improving reconnection of the tet (edge removal on its
+// six edges, 2-3 swap on its four faces), else relocation of its vertices
+// toward the position that is best in the metric (boundary ones only with a
+// model, on it), else for an isotropic field a new point in the shell of
+// one of its interior edges (shell_insert.hpp). The swap
+// planners choose their triangulation by the isotropic mean ratio; the
+// driver re-measures every candidate in the metric and keeps only those
+// that raise the worst metric quality of what they replace. A new vertex
+// gets the log-Euclidean interpolation of its edge's end metrics.
+//
+// The boundary. Without a model, boundary vertices never move nor go: a
+// boundary edge is split at its midpoint, which leaves the piecewise linear
+// surface (and the volume) as it was, and only region vertices collapse.
+// With a model (options.model, its tags those of the mesh's
+// classification), points split on boundary edges go onto the model and
+// boundary vertices collapse along their model entity (modify/split.hpp,
+// collapse.hpp). Boundary triangles are never swapped, classification is
+// kept, and no tet that is not strictly positive (exact orient3d) is ever
+// created.
+#include <cstddef>
+
+#include "curvemesh/geom/model.hpp"
+#include "curvemesh/mesh/tet_mesh.hpp"
+#include "curvemesh/optimize/metric_field.hpp"
+
+namespace cm::optimize {
+
+struct AdaptOptions {
+  int passes = 8;
+  /// Tets whose quality in the metric is below this are worked on.
+  double threshold = 0.3;
+  bool swaps = true;
+  bool relocation = true;
+  /// Edge split and collapse toward unit lengths.
+  bool split = true;
+  bool collapse = true;
+  /// Shell point insertion (shell_insert.hpp) for tets nothing else
+  /// improves; isotropic fields only.
+  bool insertion = true;
+  /// The CAD model the mesh is classified on, or nullptr (boundary kept).
+  const geom::Model* model = nullptr;
+};
+
+struct AdaptStats {
+  std::size_t splits = 0, collapses = 0, edge_removals = 0, face_swaps = 0, relocations = 0, insertions = 0;
+  int passes = 0;
+  /// Mean ratio in the metric (MetricField::tet_quality) over all tets.
+  double min_before = 0, mean_before = 0, min_after = 0, mean_after = 0;
+  std::size_t below_before = 0, below_after = 0;  ///< tets under the threshold
+  LengthStats lengths_before, lengths_after;
+  double split_seconds = 0, collapse_seconds = 0, swap_seconds = 0, relocation_seconds = 0, insertion_seconds = 0;
+  double seconds = 0;
+};
+
+/// Adapts m in place to the metric. Vertices are added (split) and removed
+/// (collapse): on return the mesh is compact (tets and vertices renumbered,
+/// adjacency valid) and `field` holds the metric of each of its vertices.
+/// Requires a valid mesh with adjacency and field.size() == m.num_verts().
+/// Throws std::invalid_argument when the sizes disagree.
+AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOptions& options = {});
+
+/// Quality of a whole mesh, for summaries before and after.
+struct MeshSummary {
+  std::size_t verts = 0, tets = 0;
+  double min_mean_ratio = 0, mean_mean_ratio = 0;
+  double min_dihedral = 0, max_dihedral = 0;  ///< degrees
+  std::size_t inverted = 0;                   ///< tets with orient3d <= 0
+  /// In the metric, when one is given (else equal to the isotropic values).
+  double min_metric_quality = 0, mean_metric_quality = 0;
+  double volume = 0;
+};
+/// Measures every tet of a compact mesh, in parallel. `field` may be null.
+MeshSummary summarize_mesh(const mesh::TetMesh& m, const MetricField* field = nullptr);
+
+}  // namespace cm::optimize

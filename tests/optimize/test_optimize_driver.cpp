@@ -1,0 +1,175 @@
+// The optimization drivers on poor meshes: perturbed and flattened Kuhn
+// boxes. Whatever they do, every tet stays positive, the boundary (vertex
+// positions, triangles and their tags) and the volume do not change, and
+// the worst tets get strictly better.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <vector>
+
+#include "curvemesh/mesh/validate.hpp"
+#include "curvemesh/optimize/adapt.hpp"
+#include "curvemesh/optimize/improve.hpp"
+#include "perturbed_box.hpp"
+
+using namespace cm;
+using namespace cm::optimize;
+
+namespace {
+
+struct Boundary {
+  std::map<VertId, Vec3> verts;  // every vertex not on a region
+  std::multiset<std::pair<std::array<VertId, 3>, std::int32_t>> tris;
+};
+
+Boundary boundary_of(const mesh::TetMesh& m) {
+  Boundary b;
+  for (VertId v = 0; v < m.num_verts(); ++v)
+    if (m.vert_class[v].dim != 3) b.verts.emplace(v, m.coords[v]);
+  for (const auto& t : m.tris) {
+    auto k = t.verts;
+    std::sort(k.begin(), k.end());
+    b.tris.emplace(k, t.face_tag);
+  }
+  return b;
+}
+
+void expect_same_boundary(const Boundary& before, const mesh::TetMesh& m) {
+  const Boundary after = boundary_of(m);
+  EXPECT_EQ(before.verts.size(), after.verts.size());
+  for (const auto& [v, x] : before.verts) EXPECT_EQ(m.coords[v], x) << "boundary vertex " << v << " moved";
+  EXPECT_TRUE(before.tris == after.tris) << "boundary triangles changed";
+}
+
+void expect_valid(const mesh::TetMesh& m) {
+  const auto r = mesh::validate(m, mesh::Level::kFull);
+  EXPECT_TRUE(r.valid()) << (r.issues.empty() ? "" : r.issues[0].message);
+  EXPECT_EQ(r.num_inverted, 0u);
+  EXPECT_EQ(r.num_flat, 0u);
+}
+
+}  // namespace
+
+TEST(ImproveDriver, PerturbedAndFlattenedBoxGetsStrictlyBetter) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE(seed);
+    auto m = test::perturbed_box(6, seed, 0.45, 25);
+    const auto before = summarize_mesh(m);
+    ASSERT_EQ(before.inverted, 0u);
+    // The fixture is really poor: flat tets and tiny angles.
+    ASSERT_LT(before.min_mean_ratio, 0.05);
+    ASSERT_LT(before.min_dihedral, 3.0);
+    const Boundary boundary = boundary_of(m);
+    const auto st = improve_quality(m);
+    const auto after = summarize_mesh(m);
+    expect_valid(m);
+    expect_same_boundary(boundary, m);
+    EXPECT_NEAR(after.volume, before.volume, 1e-12 * before.volume);
+    EXPECT_GT(after.min_mean_ratio, before.min_mean_ratio);
+    EXPECT_GT(after.min_dihedral, before.min_dihedral);
+    EXPECT_GT(after.min_mean_ratio, 0.15);  // measured: about 0.3
+    EXPECT_GT(after.min_dihedral, 5.0);
+    EXPECT_NEAR(st.min_after, after.min_mean_ratio, 1e-12);
+    EXPECT_NEAR(st.min_dihedral_after, after.min_dihedral, 1e-9);
+    EXPECT_NEAR(st.min_dihedral_before, before.min_dihedral, 1e-9);
+    EXPECT_GT(st.edge_removals + st.face_swaps, 0u);
+    EXPECT_GT(st.relocations, 0u);
+  }
+}
+
+TEST(ImproveDriver, RunningTwiceNeverMakesItWorse) {
+  auto m = test::perturbed_box(5, 7, 0.4, 10);
+  improve_quality(m);
+  const auto once = summarize_mesh(m);
+  improve_quality(m);
+  const auto twice = summarize_mesh(m);
+  expect_valid(m);
+  EXPECT_GE(twice.min_mean_ratio, once.min_mean_ratio);
+}
+
+TEST(AdaptDriver, AnisotropicMetricQualityImproves) {
+  // A box ten times longer in z with a metric asking for exactly that
+  // stretching: in the metric the perturbed mesh is a perturbed cube.
+  auto m = test::perturbed_box(5, 4, 0.4, 10, 10.0);
+  auto field = MetricField::from_tensors(std::vector<size::Metric>(m.num_verts(), Vec3(25, 25, 0.25).asDiagonal()));
+  const auto before = summarize_mesh(m, &field);
+  const Boundary boundary = boundary_of(m);
+  AdaptOptions o;
+  o.split = o.collapse = false;  // shapes only: the cells are already unit
+  const auto st = adapt_to_metric(m, field, o);
+  const auto after = summarize_mesh(m, &field);
+  expect_valid(m);
+  expect_same_boundary(boundary, m);
+  EXPECT_NEAR(after.volume, before.volume, 1e-12 * before.volume);
+  EXPECT_GT(after.min_metric_quality, before.min_metric_quality);
+  EXPECT_GT(after.min_metric_quality, 0.15);
+  EXPECT_NEAR(st.min_before, before.min_metric_quality, 1e-12);
+  EXPECT_NEAR(st.min_after, after.min_metric_quality, 1e-12);
+  // Unit cubes in the metric: cube edges (1) are in range, diagonals (1.41, 1.73) are not.
+  const auto& l = st.lengths_after;
+  EXPECT_EQ(l.in_range + l.too_short + l.too_long, l.edges);
+  EXPECT_GT(l.in_range, l.edges / 5);
+  EXPECT_GT(l.too_long, l.edges / 5);
+}
+
+TEST(AdaptDriver, RefusesAFieldOfTheWrongSize) {
+  auto m = test::perturbed_box(2, 1, 0.2, 0);
+  auto field = MetricField::from_sizes(std::vector<double>(3, 1.0));
+  EXPECT_THROW(adapt_to_metric(m, field), std::invalid_argument);
+}
+
+namespace {
+
+// Every boundary point of `before` is still a vertex of m (coordinates
+// compared exactly) and the face tags are all still there.
+void expect_boundary_points_kept(const Boundary& before, const mesh::TetMesh& m) {
+  std::set<std::array<double, 3>> points;
+  for (const Vec3& x : m.coords) points.insert({x.x(), x.y(), x.z()});
+  for (const auto& [v, x] : before.verts)
+    EXPECT_TRUE(points.count({x.x(), x.y(), x.z()})) << "boundary vertex " << v << " moved or went";
+  std::set<std::int32_t> tags_before, tags_after;
+  for (const auto& [k, tag] : before.tris) tags_before.insert(tag);
+  for (const auto& t : m.tris) tags_after.insert(t.face_tag);
+  EXPECT_EQ(tags_before, tags_after);
+}
+
+}  // namespace
+
+TEST(AdaptDriver, FinerSizeMapSplitsToUnitLengths) {
+  auto m = test::perturbed_box(4, 5, 0.3, 4);  // cells of 0.25
+  auto field = MetricField::from_sizes(std::vector<double>(m.num_verts(), 0.1));
+  const auto before = summarize_mesh(m, &field);
+  const Boundary boundary = boundary_of(m);
+  const auto st = adapt_to_metric(m, field);
+  const auto after = summarize_mesh(m, &field);
+  expect_valid(m);
+  expect_boundary_points_kept(boundary, m);
+  EXPECT_EQ(field.size(), m.num_verts());
+  EXPECT_NEAR(after.volume, before.volume, 1e-12 * before.volume);
+  EXPECT_GT(st.splits, 500u);
+  EXPECT_LT(st.lengths_before.percent_in_range(), 5.0);
+  EXPECT_GT(st.lengths_after.percent_in_range(), 60.0);
+  EXPECT_GT(after.min_mean_ratio, before.min_mean_ratio);
+  EXPECT_GT(m.num_tets(), 10 * before.tets);
+}
+
+TEST(AdaptDriver, CoarserSizeMapCollapsesInteriorVertices) {
+  auto m = test::perturbed_box(8, 6, 0.3, 0);  // cells of 0.125
+  auto field = MetricField::from_sizes(std::vector<double>(m.num_verts(), 0.3));
+  const auto before = summarize_mesh(m, &field);
+  const Boundary boundary = boundary_of(m);
+  const auto st = adapt_to_metric(m, field);
+  const auto after = summarize_mesh(m, &field);
+  expect_valid(m);
+  expect_boundary_points_kept(boundary, m);
+  EXPECT_NEAR(after.volume, before.volume, 1e-12 * before.volume);
+  EXPECT_GT(st.collapses, 50u);
+  EXPECT_LT(m.num_verts(), before.verts);
+  EXPECT_EQ(field.size(), m.num_verts());
+  // The boundary vertices cannot go: short edges remain on the boundary, but
+  // the interior ones are gone.
+  EXPECT_LT(st.lengths_after.too_short, st.lengths_before.too_short);
+  for (VertId v = 0; v < m.num_verts(); ++v) EXPECT_NE(m.vert2tet[v], kNone);
+}
