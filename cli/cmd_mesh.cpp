@@ -3,6 +3,7 @@
 // model and summarized.
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
 
 #include "commands.hpp"
 #include "curvemesh/core/timer.hpp"
@@ -156,11 +157,11 @@ int run_volume(const MeshCliOptions& o) {
   const generate::BoundaryReport rep = generate::check_boundary(*model, m, *sf.field);
   const std::size_t nt = m.num_tets();
   std::vector<double> q(nt), dmin(nt);
-  for (TetId t = 0; t < nt; ++t) {
-    const auto e = quality::evaluate_tet(m, t);
+  tbb::parallel_for(std::size_t{0}, nt, [&](std::size_t t) {
+    const auto e = quality::evaluate_tet(m, static_cast<TetId>(t));
     q[t] = e.mean_ratio;
     dmin[t] = e.min_dihedral;
-  }
+  });
   const auto qs = quality::compute_statistics(q);
   const auto ds = quality::compute_statistics(dmin);
   const auto [vol_model, vol_mesh] = volumes(*model, m);

@@ -448,5 +448,22 @@ TEST(ShapeMeasure, OnMeshAndInputChecks) {
   EXPECT_THROW(shape_measure(2, nodes, kMaxRulePoints + 1), std::invalid_argument);
 }
 
+TEST(Measures, DihedralRangeIsTheExtremesOfTheAngles) {
+  // The range ranks angles by a pseudo-angle; it must pick the same extremes
+  // as the full computation, also for slivers, needles and caps.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 20000; ++i) {
+    std::array<Vec3, 4> v;
+    for (auto& x : v) x = Vec3(u(rng), u(rng), u(rng));
+    if (i % 3 == 1) v[3] = (v[0] + v[1] + v[2]) / 3 + 1e-7 * Vec3(u(rng), u(rng), u(rng));  // cap / sliver
+    if (i % 3 == 2) v[1] = v[0] + 1e-6 * Vec3(u(rng), u(rng), u(rng));                      // needle
+    const auto all = tet_dihedral_angles(v[0], v[1], v[2], v[3]);
+    const auto range = tet_dihedral_range(v[0], v[1], v[2], v[3]);
+    ASSERT_DOUBLE_EQ(range.min, *std::min_element(all.begin(), all.end())) << i;
+    ASSERT_DOUBLE_EQ(range.max, *std::max_element(all.begin(), all.end())) << i;
+  }
+}
+
 }  // namespace
 }  // namespace cm::quality

@@ -101,9 +101,45 @@ std::array<double, 6> tet_dihedral_angles(const Vec3& a, const Vec3& b, const Ve
 }
 
 AngleRange tet_dihedral_range(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const auto angles = tet_dihedral_angles(a, b, c, d);
-  const auto [lo, hi] = std::minmax_element(angles.begin(), angles.end());
-  return {*lo, *hi};
+  // Only the two extreme angles need atan2 (the cost of this function in a
+  // mesh summary): the others are ranked by a pseudo-angle, monotone in the
+  // angle between the normals and as precise as atan2 near 0 and 180 degrees.
+  const auto n = face_normals({&a, &b, &c, &d});
+  double lo_key = INFINITY, hi_key = -INFINITY;
+  int lo = -1, hi = -1;
+  std::array<std::array<double, 2>, 6> sc{};  // |nk x nl|, nk . nl
+  for (int e = 0; e < 6; ++e) {
+    const int i = mesh::kTetEdges[e][0], j = mesh::kTetEdges[e][1];
+    int other[2], count = 0;
+    for (int k = 0; k < 4; ++k)
+      if (k != i && k != j) other[count++] = k;
+    const Vec3& nk = n[other[0]];
+    const Vec3& nl = n[other[1]];
+    double key;  // grows with the interior angle
+    if (nk.squaredNorm() == 0 || nl.squaredNorm() == 0) {
+      key = -1;  // a degenerate face: angle 0, as tet_dihedral_angles says
+    } else {
+      const double s = nk.cross(nl).norm(), cs = nk.dot(nl);
+      sc[e] = {s, cs};
+      // Pseudo-angle of the angle between the normals in [0, 2]; the
+      // interior angle is 180 degrees minus it.
+      const double between = cs >= 0 ? (s + cs > 0 ? s / (s + cs) : 0) : 1 + (-cs) / (s - cs);
+      key = 2 - between;
+    }
+    if (key < lo_key) {
+      lo_key = key;
+      lo = e;
+    }
+    if (key > hi_key) {
+      hi_key = key;
+      hi = e;
+    }
+  }
+  auto angle = [&](int e, double key) {
+    if (key < 0) return 0.0;
+    return 180.0 - std::atan2(sc[e][0], sc[e][1]) * kRadToDeg;
+  };
+  return {angle(lo, lo_key), angle(hi, hi_key)};
 }
 
 double metric_length(const Vec3& e, const Mat3& metric) {
