@@ -156,3 +156,33 @@ TEST(CurvatureSampling, RegionSizeCoversEveryBoundingFaceOnce) {
   EXPECT_LT(samples.size(), on_faces);
   EXPECT_THROW(sample_entity_size(*cyl, {3, 2}, 0.2), std::out_of_range);
 }
+
+TEST(CurvatureSampling, PlanesAndLinesAreNotEvaluated) {
+  const auto cyl = geom::make_analytic_cylinder(Vec3::Zero(), Vec3::UnitZ(), 1, 2);
+  SamplingOptions o;
+  o.rule = CurvatureRule::relative_deviation(0.05);
+  o.hmin = 1e-3;
+  o.hmax = 0.5;
+  int planes = 0;
+  for (int f = 1; f <= cyl->count(2); ++f) {
+    SamplingStats st;
+    const auto samples = sample_face_curvature(*cyl, f, o, &st);
+    if (cyl->type({2, f}) == geom::ShapeType::kPlane) {
+      ++planes;
+      EXPECT_TRUE(samples.empty());
+      EXPECT_EQ(st.evaluations + st.outside, 0u);
+    } else {
+      EXPECT_FALSE(samples.empty());
+    }
+  }
+  EXPECT_EQ(planes, 2);
+  for (int e = 1; e <= cyl->count(1); ++e) {
+    SamplingStats st;
+    const auto samples = sample_edge_curvature(*cyl, e, o, &st);
+    if (cyl->type({1, e}) == geom::ShapeType::kLine) {
+      EXPECT_EQ(st.evaluations, 0u);
+    } else if (cyl->type({1, e}) == geom::ShapeType::kCircle) {
+      EXPECT_FALSE(samples.empty());
+    }
+  }
+}

@@ -1,14 +1,10 @@
 #include "curvemesh/size/build.hpp"
 
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
-#include <unordered_map>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -31,66 +27,57 @@ const char* entity_name(int dim) {
 /// interior is at most h there; an octant the boundary crosses is covered by
 /// the boundary's own samples (sample_entity_size).
 ///
-/// The octree evaluates its fields afresh on every refinement round, at
-/// corners that mostly survive from the round before, and a point-in-solid
-/// test near a CAD boundary costs tens of microseconds: answers are kept,
-/// keyed by the point's exact coordinates (the octree computes a corner
-/// from integers, so the same corner is the same bits every round).
-class RegionSizeField final : public SizeField {
+/// A point-in-solid test near a CAD boundary costs tens of microseconds, and
+/// the octree asks for hundreds of thousands of points. But a box that meets
+/// none of the region's face boxes holds no boundary, so it is inside or
+/// outside as a whole (uniform_in), and the octree then asks once for all
+/// the octants such boxes join into; the classifier is left with the octants
+/// along the boundary.
+class RegionSizeField final : public BoxSizeField {
  public:
   RegionSizeField(const geom::Model& model, int region, double h) : model_(model), region_(region), h_(h) {
-    // Padded: the box only spares classifier calls far from the region, and
-    // a face box found by sampling may be a little tight.
+    // Padded: the boxes only spare classifier calls away from the boundary,
+    // and a face box found by sampling may be a little tight.
     const geom::BoundingBox b = model.bounding_box({3, region});
-    const Vec3 pad = Vec3::Constant(1e-3 * b.diagonal() + model.tolerance({3, region}));
-    lo_ = b.min - pad;
-    hi_ = b.max + pad;
+    const double pad = 1e-3 * b.diagonal() + model.tolerance({3, region});
+    lo_ = b.min - Vec3::Constant(pad);
+    hi_ = b.max + Vec3::Constant(pad);
+    for (const geom::OrientedUse& use : model.region_faces(region)) {
+      const geom::BoundingBox f = model.bounding_box({2, use.tag});
+      const double face_pad = pad + 1e-2 * f.diagonal();
+      face_boxes_.push_back({f.min - Vec3::Constant(face_pad), f.max + Vec3::Constant(face_pad)});
+    }
   }
 
   double size(const Vec3& x, const SizeHint& = {}) const override {
-    constexpr double kNone = std::numeric_limits<double>::infinity();
-    if ((x.array() < lo_.array()).any() || (x.array() > hi_.array()).any()) return kNone;
-    const Key key{std::bit_cast<std::uint64_t>(x.x()), std::bit_cast<std::uint64_t>(x.y()),
-                  std::bit_cast<std::uint64_t>(x.z())};
-    Shard& shard = shards_[KeyHash{}(key) % kShards];
-    {
-      const std::lock_guard<std::mutex> lock(shard.mutex);
-      if (const auto it = shard.inside.find(key); it != shard.inside.end()) return it->second ? h_ : kNone;
-    }
-    bool inside = true;
+    if (outside_box(x, x)) return kNone;
     try {
-      inside = model_.classify_point(region_, x) != geom::Containment::kOutside;
+      return model_.classify_point(region_, x) != geom::Containment::kOutside ? h_ : kNone;
     } catch (const GeometryError&) {
       // The CAD classifier found no usable ray here. A finer size than
       // needed is harmless; failing the whole field for one point is not.
+      return h_;
     }
-    const std::lock_guard<std::mutex> lock(shard.mutex);
-    shard.inside.emplace(key, inside);
-    return inside ? h_ : kNone;
+  }
+
+  bool uniform_in(const Vec3& lo, const Vec3& hi) const override {
+    if (outside_box(lo, hi)) return true;
+    for (const auto& [flo, fhi] : face_boxes_)
+      if ((lo.array() <= fhi.array()).all() && (hi.array() >= flo.array()).all()) return false;
+    return true;
   }
 
  private:
-  using Key = std::array<std::uint64_t, 3>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      std::uint64_t h = k[0] * 0x9E3779B97F4A7C15ull;
-      h = (h ^ (h >> 29) ^ k[1]) * 0xBF58476D1CE4E5B9ull;
-      h = (h ^ (h >> 31) ^ k[2]) * 0x94D049BB133111EBull;
-      return static_cast<std::size_t>(h ^ (h >> 32));
-    }
-  };
-  // Sharded so that the octree's parallel evaluation rarely waits on a lock.
-  static constexpr std::size_t kShards = 64;
-  struct Shard {
-    std::mutex mutex;
-    std::unordered_map<Key, bool, KeyHash> inside;
-  };
+  static constexpr double kNone = std::numeric_limits<double>::infinity();
+  bool outside_box(const Vec3& lo, const Vec3& hi) const {
+    return (hi.array() < lo_.array()).any() || (lo.array() > hi_.array()).any();
+  }
 
   const geom::Model& model_;
   int region_;
   double h_;
   Vec3 lo_, hi_;
-  mutable std::array<Shard, kShards> shards_;
+  std::vector<std::pair<Vec3, Vec3>> face_boxes_;
 };
 
 }  // namespace

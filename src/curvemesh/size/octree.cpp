@@ -3,8 +3,9 @@
 #include "curvemesh/core/error.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
+#include <limits>
+#include <numeric>
 #include <queue>
 #include <stdexcept>
 
@@ -33,7 +34,10 @@ constexpr double kGradeSafety = 0.85;
 // than this (relative); the last conformity pass is exact either way.
 constexpr double kConformTolerance = 1e-7;
 constexpr int kMaxConformPasses = 64;
-constexpr std::array<double, 4> kDiagonal = {0, 1, 1.4142135623730951, 1.7320508075688772};
+// Distance between corners a and b of a unit cube, indexed by a ^ b: they
+// differ in 1, 2 or 3 coordinates, along an edge, a face or the body diagonal.
+constexpr std::array<double, 8> kCornerDistance = {0, 1, 1, 1.4142135623730951, 1, 1.4142135623730951,
+                                                   1.4142135623730951, 1.7320508075688772};
 
 // Corner b of an octant: bit 0 -> +x, bit 1 -> +y, bit 2 -> +z.
 constexpr std::array<std::array<int, 3>, 8> kCorner = {
@@ -66,6 +70,60 @@ std::vector<Midpoint> make_midpoints() {
 const std::vector<Midpoint>& midpoints() {
   static const std::vector<Midpoint> m = make_midpoints();
   return m;
+}
+
+// Position on the Morton (Z-order) curve of a lattice point: the bits of x,
+// y and z interleaved, x lowest, so that the children of an octant, numbered
+// bx + 2by + 4bz, follow each other along the curve and every octant covers
+// one contiguous range of it.
+std::uint64_t spread_bits(std::uint64_t v) {
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffull;
+  v = (v | v << 16) & 0x1f0000ff0000ffull;
+  v = (v | v << 8) & 0x100f00f00f00f00full;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+  v = (v | v << 2) & 0x1249249249249249ull;
+  return v;
+}
+std::uint64_t morton(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) {
+  return spread_bits(ix) | spread_bits(iy) << 1 | spread_bits(iz) << 2;
+}
+
+constexpr std::uint32_t kNone32 = std::numeric_limits<std::uint32_t>::max();
+
+// Open-addressing table of field values by lattice key (FieldState).
+constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
+std::size_t value_slot(const std::vector<std::uint64_t>& keys, std::uint64_t k) {
+  const std::size_t mask = keys.size() - 1;
+  for (std::size_t i = static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> 20) & mask;; i = (i + 1) & mask)
+    if (keys[i] == k || keys[i] == kNoKey) return i;
+}
+void reserve_values(std::vector<std::uint64_t>& keys, std::vector<double>& values, std::size_t count) {
+  if (2 * count <= keys.size()) return;
+  std::size_t capacity = std::max<std::size_t>(keys.size(), 1024);
+  while (2 * count > capacity) capacity *= 2;
+  std::vector<std::uint64_t> old_keys(capacity, kNoKey);
+  std::vector<double> old_values(capacity);
+  old_keys.swap(keys);
+  old_values.swap(values);
+  for (std::size_t i = 0; i < old_keys.size(); ++i)
+    if (old_keys[i] != kNoKey) {
+      const std::size_t slot = value_slot(keys, old_keys[i]);
+      keys[slot] = old_keys[i];
+      values[slot] = old_values[i];
+    }
+}
+
+// Disjoint sets of leaves whose root is the smallest member, so that which
+// leaf stands for a set does not depend on the order sets were joined in.
+std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t a) {
+  while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  return a;
+}
+void join(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b) {
+  a = find_root(parent, a);
+  b = find_root(parent, b);
+  if (a != b) parent[std::max(a, b)] = std::min(a, b);
 }
 
 }  // namespace
@@ -159,15 +217,6 @@ void SizeOctree::split(std::uint32_t o) {
                         parent.iz + kCorner[c][2] * half, -1, static_cast<std::uint8_t>(parent.level + 1)});
 }
 
-void SizeOctree::refine_to(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz, int level) {
-  level = std::min(level, opt_.max_depth);
-  std::uint32_t o = find(ix, iy, iz);
-  while (octants_[o].level < level) {
-    split(o);
-    o = find(ix, iy, iz);
-  }
-}
-
 void SizeOctree::insert(const Vec3& x, double h, SizeSource source) {
   if (built_) throw std::logic_error("size octree: insert after build()");
   if (!x.allFinite() || std::isnan(h) || !(h > 0))
@@ -177,9 +226,17 @@ void SizeOctree::insert(const Vec3& x, double h, SizeSource source) {
     source = SizeSource::kHmin;
   }
   if (h >= opt_.hmax) return;  // the default already
+  if (requests_.size() >= kNone32) throw std::length_error("size octree: too many requests");
+  const int level = std::min(octree_level(side_, h), opt_.max_depth);
   const auto u = to_units(x);
-  refine_to(u[0], u[1], u[2], octree_level(side_, h));
-  requests_.push_back({x, h, source});
+  std::uint32_t o = find(u[0], u[1], u[2]);
+  while (octants_[o].level < level) {
+    split(o);
+    const int bit = opt_.max_depth - octants_[o].level - 1;
+    o = static_cast<std::uint32_t>(octants_[o].first_child) +
+        (((u[0] >> bit) & 1u) | (((u[1] >> bit) & 1u) << 1) | (((u[2] >> bit) & 1u) << 2));
+  }
+  requests_.push_back({x, h, source, level});
 }
 
 void SizeOctree::insert(std::span<const SizeSample> samples) {
@@ -189,21 +246,33 @@ void SizeOctree::insert(std::span<const SizeSample> samples) {
 void SizeOctree::insert_field(std::shared_ptr<const SizeField> field) {
   if (built_) throw std::logic_error("size octree: insert_field after build()");
   if (!field) throw std::invalid_argument("size octree: null field");
-  fields_.push_back(std::move(field));
+  FieldState state;
+  state.boxes = dynamic_cast<const BoxSizeField*>(field.get());
+  state.field = std::move(field);
+  fields_.push_back(std::move(state));
 }
 
+// Depth first, children in order: the leaves come out in Morton order.
 std::vector<std::uint32_t> SizeOctree::leaf_octants() const {
-  std::vector<std::uint32_t> out;
-  for (std::uint32_t o = 0; o < octants_.size(); ++o)
-    if (octants_[o].first_child < 0) out.push_back(o);
+  std::vector<std::uint32_t> out, stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t o = stack.back();
+    stack.pop_back();
+    if (octants_[o].first_child < 0) {
+      out.push_back(o);
+      continue;
+    }
+    for (std::uint32_t c = 8; c-- > 0;) stack.push_back(static_cast<std::uint32_t>(octants_[o].first_child) + c);
+  }
   return out;
 }
 
 // 2:1 across faces, edges and corners: a leaf's 26 neighbouring leaves are at
 // most one level coarser. Keeps interpolation smooth and bounds the hanging
-// corners to edge midpoints and face centres.
-void SizeOctree::balance() {
-  std::vector<std::uint32_t> work = leaf_octants();
+// corners to edge midpoints and face centres. `work` holds the leaves made
+// since the tree was last balanced: only those can be two levels finer than
+// a neighbour (an old leaf next to a new one was next to its old ancestor).
+void SizeOctree::balance(std::vector<std::uint32_t> work) {
   const std::int64_t top = std::int64_t{1} << opt_.max_depth;
   while (!work.empty()) {
     const std::uint32_t o = work.back();
@@ -231,6 +300,9 @@ void SizeOctree::balance() {
 
 void SizeOctree::assign_corners() {
   leaves_ = leaf_octants();
+  by_octant_.resize(leaves_.size());
+  std::iota(by_octant_.begin(), by_octant_.end(), 0u);
+  std::sort(by_octant_.begin(), by_octant_.end(), [&](std::uint32_t a, std::uint32_t b) { return leaves_[a] < leaves_[b]; });
   octant_leaf_.assign(octants_.size(), -1);
   leaf_nodes_.resize(leaves_.size());
   node_of_.reset(2 * leaves_.size() + 8);  // corners <= 8 per leaf, ~1.2 per leaf in practice
@@ -251,33 +323,121 @@ void SizeOctree::assign_corners() {
   const std::size_t n = node_units_.size();
   node_value_.assign(n, opt_.hmax);
   node_source_.assign(n, SizeSource::kHmax);
-  const auto lower = [&](std::uint32_t node, double h, SizeSource src) {
+  // Leaves and requests are both in Morton order: one merge finds every
+  // request's leaf. Per corner the smallest size wins, and among equal
+  // sizes the request inserted first.
+  std::vector<std::uint32_t> winner(n, kNone32);
+  std::size_t k = 0;
+  for (std::size_t l = 0; l < leaves_.size() && k < request_order_.size(); ++l) {
+    const Octant& o = octants_[leaves_[l]];
+    const Key end = morton(o.ix, o.iy, o.iz) + (Key{1} << (3 * (opt_.max_depth - o.level)));
+    double best_h = std::numeric_limits<double>::infinity();
+    std::uint32_t best = kNone32;
+    for (; k < request_order_.size() && request_order_[k].first < end; ++k) {
+      const std::uint32_t i = request_order_[k].second;
+      if (requests_[i].h < best_h || (requests_[i].h == best_h && i < best)) {
+        best_h = requests_[i].h;
+        best = i;
+      }
+    }
+    if (best == kNone32) continue;
+    for (const std::uint32_t node : leaf_nodes_[l])
+      if (best_h < node_value_[node] || (best_h == node_value_[node] && best < winner[node])) {
+        node_value_[node] = best_h;
+        node_source_[node] = requests_[best].source;
+        winner[node] = best;
+      }
+  }
+  for (FieldState& field : fields_) evaluate_field(field);
+}
+
+// A field's value at every corner and at every leaf's centre (at the finest
+// level: its lowest corner), each lowering the corners of its leaves.
+void SizeOctree::evaluate_field(FieldState& st) {
+  const std::size_t n = node_units_.size(), nl = leaves_.size();
+  constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> at_node(n, kUnknown), at_centre(nl, kUnknown);
+  const auto clamped = [&](const Vec3& x) { return std::clamp(st.field->size(x), opt_.hmin, opt_.hmax); };
+  const auto centre_units = [&](const Octant& o) {
+    const std::uint32_t h = o.level < opt_.max_depth ? units(o.level) / 2 : 0;
+    return std::array<std::uint32_t, 3>{o.ix + h, o.iy + h, o.iz + h};
+  };
+  if (st.boxes) {
+    // Leaves the field vouches for, joined through shared corners: one value
+    // per joined set, taken at the centre of its first leaf.
+    std::vector<char> uniform(nl);
+    tbb::parallel_for(std::size_t{0}, nl, [&](std::size_t l) {
+      const Octant& o = octants_[leaves_[l]];
+      const Vec3 lo = to_point(o.ix, o.iy, o.iz);
+      uniform[l] = st.boxes->uniform_in(lo, lo + Vec3::Constant(leaf_side_[l]));
+    });
+    std::vector<std::uint32_t> set(nl), first_leaf(n, kNone32);
+    std::iota(set.begin(), set.end(), 0u);
+    for (std::uint32_t l = 0; l < nl; ++l) {
+      if (!uniform[l]) continue;
+      for (const std::uint32_t node : leaf_nodes_[l]) {
+        if (first_leaf[node] == kNone32)
+          first_leaf[node] = l;
+        else
+          join(set, l, first_leaf[node]);
+      }
+    }
+    std::vector<std::uint32_t> roots;
+    for (std::uint32_t l = 0; l < nl; ++l)
+      if (uniform[l] && find_root(set, l) == l) roots.push_back(l);
+    tbb::parallel_for(std::size_t{0}, roots.size(), [&](std::size_t r) {
+      const auto c = centre_units(octants_[leaves_[roots[r]]]);
+      at_centre[roots[r]] = clamped(to_point(c[0], c[1], c[2]));
+    });
+    for (std::uint32_t l = 0; l < nl; ++l) {
+      if (!uniform[l]) continue;
+      const double v = at_centre[find_root(set, l)];
+      at_centre[l] = v;
+      for (const std::uint32_t node : leaf_nodes_[l]) at_node[node] = v;
+    }
+  }
+  // Every other point: its value from an earlier round, or evaluated now,
+  // each distinct point once.
+  std::vector<double*> targets;
+  std::vector<std::size_t> target_slot;
+  reserve_values(st.keys, st.values, st.count + n + nl);
+  const auto want = [&](const std::array<std::uint32_t, 3>& u, double* out) {
+    const Key k = key(u[0], u[1], u[2]);
+    const std::size_t slot = value_slot(st.keys, k);
+    if (st.keys[slot] == kNoKey) {
+      st.keys[slot] = k;
+      st.values[slot] = kUnknown;
+      ++st.count;
+    }
+    targets.push_back(out);
+    target_slot.push_back(slot);
+  };
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::isnan(at_node[i])) want(node_units_[i], &at_node[i]);
+  for (std::size_t l = 0; l < nl; ++l)
+    if (std::isnan(at_centre[l])) want(centre_units(octants_[leaves_[l]]), &at_centre[l]);
+  std::vector<std::size_t> fresh;
+  for (const std::size_t slot : target_slot)
+    if (std::isnan(st.values[slot])) {
+      st.values[slot] = 0;  // listed once
+      fresh.push_back(slot);
+    }
+  tbb::parallel_for(std::size_t{0}, fresh.size(), [&](std::size_t i) {
+    constexpr Key kMask = (Key{1} << 21) - 1;
+    const Key k = st.keys[fresh[i]];
+    st.values[fresh[i]] = clamped(to_point(k & kMask, (k >> 21) & kMask, k >> 42));
+  });
+  for (std::size_t t = 0; t < targets.size(); ++t) *targets[t] = st.values[target_slot[t]];
+
+  const auto lower = [&](std::uint32_t node, double h) {
     if (h < node_value_[node]) {
       node_value_[node] = h;
-      node_source_[node] = src;
+      node_source_[node] = SizeSource::kField;
     }
   };
-  for (const Request& r : requests_) {
-    const auto u = to_units(r.x);
-    const std::int32_t l = octant_leaf_[find(u[0], u[1], u[2])];
-    for (const std::uint32_t node : leaf_nodes_[l]) lower(node, r.h, r.source);
-  }
-  for (const auto& field : fields_) {
-    const auto clamped = [&](const Vec3& x) { return std::clamp(field->size(x), opt_.hmin, opt_.hmax); };
-    std::vector<double> at_node(n), at_centre(leaves_.size());
-    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      at_node[i] = clamped(to_point(node_units_[i][0], node_units_[i][1], node_units_[i][2]));
-    });
-    tbb::parallel_for(std::size_t{0}, leaves_.size(), [&](std::size_t l) {
-      const Octant& o = octants_[leaves_[l]];
-      const std::uint64_t h = units(o.level) / 2;
-      at_centre[l] = o.level < opt_.max_depth ? clamped(to_point(o.ix + h, o.iy + h, o.iz + h))
-                                              : clamped(to_point(o.ix, o.iy, o.iz));
-    });
-    for (std::size_t i = 0; i < n; ++i) lower(std::uint32_t(i), at_node[i], SizeSource::kField);
-    for (std::size_t l = 0; l < leaves_.size(); ++l)
-      for (const std::uint32_t node : leaf_nodes_[l]) lower(node, at_centre[l], SizeSource::kField);
-  }
+  for (std::size_t i = 0; i < n; ++i) lower(std::uint32_t(i), at_node[i]);
+  for (std::size_t l = 0; l < nl; ++l)
+    for (const std::uint32_t node : leaf_nodes_[l]) lower(node, at_centre[l]);
 }
 
 // Node -> incident leaves, corner positions and the hanging corners, once
@@ -305,8 +465,13 @@ void SizeOctree::build_incidence() {
       if (node >= 0) hanging_.push_back({l, static_cast<std::uint32_t>(node), static_cast<std::uint8_t>(k)});
     }
   }
-  std::stable_sort(hanging_.begin(), hanging_.end(), [&](const Hanging& a, const Hanging& b) {
-    return octants_[leaves_[a.leaf]].level > octants_[leaves_[b.leaf]].level;
+  // Conformity is settled finest first and, within a level, in the order
+  // octants were made: lowering one face's corners changes what the next
+  // face needs, so this order is part of the result.
+  std::sort(hanging_.begin(), hanging_.end(), [&](const Hanging& a, const Hanging& b) {
+    const std::uint32_t oa = leaves_[a.leaf], ob = leaves_[b.leaf];
+    if (octants_[oa].level != octants_[ob].level) return octants_[oa].level > octants_[ob].level;
+    return oa != ob ? oa < ob : a.midpoint < b.midpoint;
   });
 }
 
@@ -330,8 +495,7 @@ void SizeOctree::grade(std::span<const std::uint32_t> seeds) {
       const auto& corners = leaf_nodes_[leaf];
       for (std::uint32_t cb = 0; cb < 8; ++cb) {
         if (cb == ca) continue;
-        // Corners differing in 1, 2 or 3 coordinates: edge, face or body diagonal.
-        const double cand = h + step * kDiagonal[std::popcount(ca ^ cb)];
+        const double cand = h + step * kCornerDistance[ca ^ cb];
         const std::uint32_t b = corners[cb];
         if (cand < node_value_[b] * (1 - kConformTolerance)) {
           node_value_[b] = cand;
@@ -402,9 +566,10 @@ std::vector<std::uint32_t> SizeOctree::conform() {
   return moved;
 }
 
-bool SizeOctree::refine_to_sizes() {
-  bool refined = false;
-  for (std::size_t l = 0; l < leaves_.size(); ++l) {
+// Returns the leaves it made.
+std::vector<std::uint32_t> SizeOctree::refine_to_sizes() {
+  std::vector<std::uint32_t> made, stack;
+  for (const std::uint32_t l : by_octant_) {
     const Octant o = octants_[leaves_[l]];
     double smallest = opt_.hmax;
     for (const std::uint32_t node : leaf_nodes_[l]) smallest = std::min(smallest, node_value_[node]);
@@ -413,24 +578,35 @@ bool SizeOctree::refine_to_sizes() {
     // smaller than interpolated, and a margin saves a whole round for them.
     const int want = std::min({octree_level(side_, kRefineMargin * kResolution * smallest), opt_.max_depth,
                                o.level + kMaxLevelJump});
-    refined = true;
     // Every descendant down to `want`.
-    std::vector<std::uint32_t> stack{leaves_[l]};
+    stack.assign(1, leaves_[l]);
     while (!stack.empty()) {
       const std::uint32_t q = stack.back();
       stack.pop_back();
-      if (octants_[q].level >= want) continue;
+      if (octants_[q].level >= want) {
+        made.push_back(q);
+        continue;
+      }
       split(q);
       for (std::uint32_t c = 0; c < 8; ++c) stack.push_back(static_cast<std::uint32_t>(octants_[q].first_child) + c);
     }
   }
-  return refined;
+  std::sort(made.begin(), made.end());
+  return made;
 }
 
 void SizeOctree::build() {
   if (built_) throw std::logic_error("size octree: build() called twice");
+  request_order_.resize(requests_.size());
+  for (std::uint32_t i = 0; i < requests_.size(); ++i) {
+    const auto u = to_units(requests_[i].x);
+    request_order_[i] = {morton(u[0], u[1], u[2]), i};
+  }
+  std::sort(request_order_.begin(), request_order_.end());
+  std::vector<std::uint32_t> fresh = leaf_octants();
+  std::sort(fresh.begin(), fresh.end());
   for (rounds_ = 1;; ++rounds_) {
-    balance();
+    balance(std::move(fresh));
     assign_corners();
     build_incidence();
     std::vector<std::uint32_t> seeds(node_value_.size());
@@ -439,7 +615,9 @@ void SizeOctree::build() {
       grade(seeds);
       seeds = conform();
     }
-    if (rounds_ >= 4 * opt_.max_depth || !refine_to_sizes()) break;
+    if (rounds_ >= 4 * opt_.max_depth) break;
+    fresh = refine_to_sizes();
+    if (fresh.empty()) break;
   }
   built_ = true;
 }
@@ -462,9 +640,10 @@ double SizeOctree::size(const Vec3& x, const SizeHint&) const {
 std::vector<SizeOctree::Leaf> SizeOctree::leaves() const {
   if (!built_) throw std::logic_error("size octree: leaves() before build()");
   std::vector<Leaf> out(leaves_.size());
-  for (std::size_t l = 0; l < leaves_.size(); ++l) {
+  for (std::size_t i = 0; i < leaves_.size(); ++i) {
+    const std::uint32_t l = by_octant_[i];
     const Octant& o = octants_[leaves_[l]];
-    Leaf& leaf = out[l];
+    Leaf& leaf = out[i];
     leaf.lo = to_point(o.ix, o.iy, o.iz);
     leaf.level = o.level;
     leaf.side = std::ldexp(side_, -o.level);
@@ -485,17 +664,21 @@ std::vector<SizeOctree::Leaf> SizeOctree::leaves() const {
 std::vector<std::array<std::size_t, 2>> SizeOctree::face_neighbours() const {
   if (!built_) throw std::logic_error("size octree: face_neighbours() before build()");
   std::vector<std::array<std::size_t, 2>> out;
+  // Indices as leaves() numbers them.
+  std::vector<std::size_t> position(leaves_.size());
+  for (std::size_t i = 0; i < by_octant_.size(); ++i) position[by_octant_[i]] = i;
   const std::int64_t top = std::int64_t{1} << opt_.max_depth;
-  for (std::size_t l = 0; l < leaves_.size(); ++l) {
-    const Octant& o = octants_[leaves_[l]];
+  for (std::size_t i = 0; i < leaves_.size(); ++i) {
+    const std::size_t l = position[i];
+    const Octant& o = octants_[leaves_[i]];
     const std::int64_t s = units(o.level);
     for (int axis = 0; axis < 3; ++axis)
       for (const int dir : {-1, 1}) {
         std::array<std::int64_t, 3> p{o.ix, o.iy, o.iz};
         p[axis] += dir < 0 ? -1 : s;
         if (p[axis] < 0 || p[axis] >= top) continue;
-        const std::size_t other = static_cast<std::size_t>(
-            octant_leaf_[find(std::uint32_t(p[0]), std::uint32_t(p[1]), std::uint32_t(p[2]))]);
+        const std::size_t other = position[static_cast<std::size_t>(
+            octant_leaf_[find(std::uint32_t(p[0]), std::uint32_t(p[1]), std::uint32_t(p[2]))])];
         out.push_back({std::min(l, other), std::max(l, other)});
       }
   }

@@ -10,6 +10,10 @@
 // or edge of a larger neighbour (a hanging corner) takes the value the larger
 // octant interpolates there.
 //
+// Requests are only recorded by insert(); build() refines for all of them at
+// once, top-down over the requests sorted along the Morton curve, and keeps
+// leaves and corners in that order so that neighbours are near in memory.
+//
 // build() then
 // - balances the tree 2:1 across faces, edges and corners;
 // - spreads small sizes by the gradation bound h(b) <= h(a) + (hgrad−1)|ab|
@@ -40,17 +44,33 @@ struct OctreeOptions {
   int max_depth = 20;   ///< deepest level (L / 2^20 ~ 1e-6 L)
 };
 
+/// A field that can vouch for whole boxes: uniform_in(lo, hi) true means the
+/// field changes value nowhere in or near the closed box, so it has one value
+/// on the box and on any box that shares a point with it and is vouched for
+/// too (a size inside a region, away from the region's boundary). The
+/// octree then evaluates it once per connected set of such octants instead
+/// of at each of their corners. False is always a correct answer.
+class BoxSizeField : public SizeField {
+ public:
+  virtual bool uniform_in(const Vec3& lo, const Vec3& hi) const = 0;
+};
+
 class SizeOctree final : public SizeField {
  public:
   /// Root cube: centred on the box, side its largest extent plus 2%.
   /// Throws std::invalid_argument for an empty box or bad options.
   SizeOctree(const geom::BoundingBox& box, const OctreeOptions& options);
 
-  /// Asks for size h at x (clamped to [hmin, hmax]); refines to eq. 4.6's level.
+  /// Asks for size h at x (clamped to [hmin, hmax]); build() refines to eq.
+  /// 4.6's level there. Where requests tie on the smallest size, the first
+  /// inserted names the source.
   void insert(const Vec3& x, double h, SizeSource source);
   void insert(std::span<const SizeSample> samples);
-  /// Adds a field evaluated at every octant corner and centre during build();
-  /// octants are refined where it asks for less than their side.
+  /// Adds a field evaluated at every octant corner and centre during build()
+  /// (once per point: values are kept across refinement rounds; a
+  /// BoxSizeField once per uniform set of octants); octants are refined where
+  /// it asks for less than their side. Evaluated in parallel: the field must
+  /// be thread-safe, and the tree is the same for any number of threads.
   void insert_field(std::shared_ptr<const SizeField> field);
   /// Balances, grades and resolves (see above). Inserting after build() is an error.
   void build();
@@ -89,8 +109,18 @@ class SizeOctree final : public SizeField {
     Vec3 x;
     double h;
     SizeSource source;
+    int level;
   };
   using Key = std::uint64_t;
+  // Values of a field at points of the finest lattice, kept across rounds:
+  // most corners and centres of a round are corners of the next.
+  struct FieldState {
+    std::shared_ptr<const SizeField> field;
+    const BoxSizeField* boxes = nullptr;  // the same field when it vouches for boxes
+    std::vector<Key> keys;                // open addressing; ~0 marks an empty slot
+    std::vector<double> values;
+    std::size_t count = 0;
+  };
 
   std::uint32_t units(int level) const { return std::uint32_t{1} << (opt_.max_depth - level); }
   std::array<std::uint32_t, 3> to_units(const Vec3& x) const;
@@ -98,26 +128,32 @@ class SizeOctree final : public SizeField {
   static Key key(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) { return ix | (iy << 21) | (iz << 42); }
   std::uint32_t find(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const;
   void split(std::uint32_t octant);
-  void refine_to(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz, int level);
   std::vector<std::uint32_t> leaf_octants() const;
-  void balance();
+  void balance(std::vector<std::uint32_t> work);
   void assign_corners();
+  void evaluate_field(FieldState& state);
   void build_incidence();
   void grade(std::span<const std::uint32_t> seeds);
   std::vector<std::uint32_t> conform();
-  bool refine_to_sizes();
+  std::vector<std::uint32_t> refine_to_sizes();
 
   OctreeOptions opt_;
   Vec3 origin_;
   double side_ = 0;
   std::vector<Octant> octants_;
   std::vector<Request> requests_;
-  std::vector<std::shared_ptr<const SizeField>> fields_;
+  // (Morton key of the request's point, request index), sorted by build().
+  std::vector<std::pair<Key, std::uint32_t>> request_order_;
+  std::vector<FieldState> fields_;
   bool built_ = false;
   int rounds_ = 0;
 
   // Corner data, rebuilt by assign_corners().
-  std::vector<std::uint32_t> leaves_;                        // octant ids of the leaves
+  std::vector<std::uint32_t> leaves_;                        // octant ids of the leaves, in Morton order
+  // Leaf indices by increasing octant id: the order leaves() reports and
+  // refinement visits them in, which depends on when octants were made and
+  // not on how the leaves are laid out.
+  std::vector<std::uint32_t> by_octant_;
   std::vector<std::int32_t> octant_leaf_;                    // octant -> leaf index or -1
   std::vector<std::array<std::uint32_t, 8>> leaf_nodes_;     // corner ids per leaf
   // Corner key -> corner id: open addressing, rebuilt with the corners.

@@ -63,7 +63,8 @@ struct SamplingStats {
   SamplingStats& operator+=(const SamplingStats& o);
 };
 
-/// Curvature samples of one face (those asking for less than hmax).
+/// Curvature samples of one face (those asking for less than hmax). Planes
+/// and lines are not sampled: they ask for nothing.
 std::vector<SizeSample> sample_face_curvature(const geom::Model& model, int face, const SamplingOptions& opt,
                                               SamplingStats* stats = nullptr);
 /// Curvature samples of one edge (none for a degenerate edge).
