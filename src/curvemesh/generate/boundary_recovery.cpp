@@ -4,7 +4,6 @@
 #include <cmath>
 #include <optional>
 #include <unordered_map>
-#include <unordered_set>
 
 #include <fmt/format.h>
 
@@ -17,12 +16,6 @@ namespace cm::generate {
 namespace {
 
 using Triple = std::array<VertId, 3>;
-struct TripleHash {
-  std::size_t operator()(const Triple& k) const {
-    return (std::size_t{k[0]} * 0x9E3779B97F4A7C15ull) ^ (std::size_t{k[1]} * 0xC2B2AE3D27D4EB4Full) ^
-           (std::size_t{k[2]} * 0x165667B19E3779F9ull);
-  }
-};
 Triple sorted3(Triple k) {
   std::sort(k.begin(), k.end());
   return k;
@@ -231,6 +224,8 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   const auto max_steiner = static_cast<std::size_t>(o.max_steiner_factor * static_cast<double>(surface_verts)) + 1000;
   std::vector<std::pair<VertId, VertId>> to_split;
   std::vector<TetId> ball;
+  std::vector<std::uint64_t> all_edges;
+  std::vector<Triple> all_faces;
   int last_face = 0;
   auto split_and_insert = [&](VertId a, VertId b) {
     const VertId p = surf.split(a, b, st);
@@ -306,19 +301,28 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     // Read every tet once rather than walking a ball per surface simplex:
     // balls of a boundary-only Delaunay mesh can hold thousands of tets.
     // Only simplices at a vertex under check are collected.
-    std::unordered_set<std::uint64_t> all_edges;
-    std::unordered_set<Triple, TripleHash> all_faces;
+    // Sorted arrays rather than hash sets: built once per round and only
+    // searched, they take a third of the memory and no allocation per entry.
+    all_edges.clear();
+    all_faces.clear();
     for (TetId t = 0; t < m.tet2verts.size(); ++t) {
       if (dt.editor().is_dead(t)) continue;
       const auto& tv = m.tet2verts[t];
       if (!check(tv[0]) && !check(tv[1]) && !check(tv[2]) && !check(tv[3])) continue;
       for (const auto& e : mesh::kTetEdges)
-        if (check(tv[e[0]]) || check(tv[e[1]])) all_edges.insert(edge_key(tv[e[0]], tv[e[1]]));
+        if (check(tv[e[0]]) || check(tv[e[1]])) all_edges.push_back(edge_key(tv[e[0]], tv[e[1]]));
       for (const auto& f : mesh::kFaceVerts)
-        if (check(tv[f[0]]) || check(tv[f[1]]) || check(tv[f[2]])) all_faces.insert(sorted3({tv[f[0]], tv[f[1]], tv[f[2]]}));
+        if (check(tv[f[0]]) || check(tv[f[1]]) || check(tv[f[2]]))
+          all_faces.push_back(sorted3({tv[f[0]], tv[f[1]], tv[f[2]]}));
     }
-    auto edge_in = [&](VertId a, VertId b) { return all_edges.count(edge_key(a, b)) != 0; };
-    auto face_in = [&](const std::array<VertId, 3>& v) { return all_faces.count(sorted3(v)) != 0; };
+    std::sort(all_edges.begin(), all_edges.end());
+    std::sort(all_faces.begin(), all_faces.end());
+    auto edge_in = [&](VertId a, VertId b) {
+      return std::binary_search(all_edges.begin(), all_edges.end(), edge_key(a, b));
+    };
+    auto face_in = [&](const std::array<VertId, 3>& v) {
+      return std::binary_search(all_faces.begin(), all_faces.end(), sorted3(v));
+    };
     for (const auto& [key, tris] : surf.edges()) {
       const auto a = static_cast<VertId>(key >> 32), b = static_cast<VertId>(key & 0xFFFFFFFFu);
       if (!check(a) && !check(b)) continue;
