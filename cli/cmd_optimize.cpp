@@ -2,8 +2,13 @@
 // mesh (paper 2): isotropic shape, or shape and lengths in a size map or a
 // metric field given per vertex.
 #include <algorithm>
+#include <cmath>
+#include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -16,6 +21,7 @@
 #include "curvemesh/io/mesh_io.hpp"
 #include "curvemesh/mesh/validate.hpp"
 #include "curvemesh/optimize/adapt.hpp"
+#include "curvemesh/optimize/boundary_limit.hpp"
 #include "curvemesh/optimize/improve.hpp"
 #include "curvemesh/optimize/metric_field.hpp"
 #include "curvemesh/size/expression.hpp"
@@ -27,7 +33,7 @@ namespace cm::cli {
 namespace {
 
 struct OptimizeCliOptions {
-  std::string input, output, json_path, model, sol, sol_out, size_expr;
+  std::string input, output, json_path, model, sol, sol_out, size_expr, metric_expr;
   double hmin = 0, hmax = 0, hgrad = 1.3;
   bool aniso = false, binary = false, quiet = false;
   int passes = 8;
@@ -37,14 +43,89 @@ struct OptimizeCliOptions {
 };
 
 bool has_size_spec(const OptimizeCliOptions& o) {
-  return !o.sol.empty() || !o.size_expr.empty() || o.hmin > 0 || o.hmax > 0 || o.aniso;
+  return !o.sol.empty() || !o.size_expr.empty() || !o.metric_expr.empty() || o.hmin > 0 || o.hmax > 0 || o.aniso;
 }
+
+// A size function clamped to [hmin, hmax] (a bound <= 0 is not applied), as
+// clamp_sizes clamps the values sampled at the vertices.
+class ClampedField final : public size::SizeField {
+ public:
+  ClampedField(std::shared_ptr<const size::SizeField> inner, double hmin, double hmax)
+      : inner_(std::move(inner)), hmin_(hmin > 0 ? hmin : 0), hmax_(hmax > 0 ? hmax : HUGE_VAL) {}
+  double size(const Vec3& x, const size::SizeHint& hint = {}) const override {
+    return std::clamp(inner_->size(x, hint), hmin_, hmax_);
+  }
+  size::Metric metric(const Vec3& x, const size::SizeHint& hint = {}) const override {
+    if (!inner_->anisotropic()) return size::isotropic_metric(size(x, hint));
+    const Eigen::SelfAdjointEigenSolver<size::Metric> eig(inner_->metric(x, hint));
+    Vec3 l = eig.eigenvalues();
+    for (int k = 0; k < 3; ++k) l[k] = std::clamp(l[k], 1 / (hmax_ * hmax_), 1 / (hmin_ * hmin_));
+    return eig.eigenvectors() * l.asDiagonal() * eig.eigenvectors().transpose();
+  }
+  bool anisotropic() const override { return inner_->anisotropic(); }
+
+ private:
+  std::shared_ptr<const size::SizeField> inner_;
+  double hmin_, hmax_;
+};
+
+// Sizes along x, y and z: the metric diag(1/hx², 1/hy², 1/hz²).
+class AxisSizeField final : public size::SizeField {
+ public:
+  explicit AxisSizeField(std::array<std::shared_ptr<const size::SizeField>, 3> axes) : axes_(std::move(axes)) {}
+  double size(const Vec3& x, const size::SizeHint& hint = {}) const override {
+    return std::min({axes_[0]->size(x, hint), axes_[1]->size(x, hint), axes_[2]->size(x, hint)});
+  }
+  size::Metric metric(const Vec3& x, const size::SizeHint& hint = {}) const override {
+    size::Metric m = size::Metric::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const double h = axes_[static_cast<std::size_t>(k)]->size(x, hint);
+      m(k, k) = 1 / (h * h);
+    }
+    return m;
+  }
+  bool anisotropic() const override { return true; }
+
+ private:
+  std::array<std::shared_ptr<const size::SizeField>, 3> axes_;
+};
+
+std::shared_ptr<const size::SizeField> parse_metric_expr(const std::string& text) {
+  std::vector<std::string> parts;
+  for (std::size_t begin = 0;;) {
+    const std::size_t end = text.find(';', begin);
+    parts.push_back(text.substr(begin, end == std::string::npos ? end : end - begin));
+    if (end == std::string::npos) break;
+    begin = end + 1;
+  }
+  if (parts.size() != 3)
+    throw InputError("--metric-expr", -1, -1,
+                     fmt::format("needs three sizes 'hx; hy; hz', got {} expression(s)", parts.size()));
+  std::array<std::shared_ptr<const size::SizeField>, 3> axes;
+  for (std::size_t k = 0; k < 3; ++k) {
+    try {
+      axes[k] = size::make_expression_field(parts[k]);
+    } catch (const std::exception& e) {
+      throw InputError("--metric-expr", -1, -1, fmt::format("size along {}: {}", "xyz"[k], e.what()));
+    }
+  }
+  return std::make_shared<AxisSizeField>(std::move(axes));
+}
+
+struct SizeSpec {
+  optimize::MetricField field;
+  /// The analytic function behind it (clamped), when there is one.
+  std::shared_ptr<const size::SizeField> analytic;
+};
 
 // The size specification at the input's vertices, or nothing (isotropic
 // shape only). Errors name the option or file at fault.
-std::optional<optimize::MetricField> make_metric(const OptimizeCliOptions& o, const mesh::TetMesh& m) {
+std::optional<SizeSpec> make_metric(const OptimizeCliOptions& o, const mesh::TetMesh& m) {
   if (!has_size_spec(o)) return std::nullopt;
-  optimize::MetricField field;
+  if (o.hmin > 0 && o.hmax > 0 && o.hmin > o.hmax)
+    throw InputError("--hmin/--hmax", -1, -1, fmt::format("hmin {} is larger than hmax {}", o.hmin, o.hmax));
+  SizeSpec spec;
+  optimize::MetricField& field = spec.field;
   if (!o.sol.empty()) {
     const io::SolField sol = io::read_sol(io::read_file_bytes(o.sol), o.sol);
     try {
@@ -53,12 +134,20 @@ std::optional<optimize::MetricField> make_metric(const OptimizeCliOptions& o, co
     } catch (const std::invalid_argument& e) {
       throw InputError(o.sol, -1, -1, fmt::format("{} ({})", e.what(), o.input));
     }
-  } else if (!o.size_expr.empty()) {
-    const auto expr = size::make_expression_field(o.size_expr);
+  } else if (!o.size_expr.empty() || !o.metric_expr.empty()) {
+    std::shared_ptr<const size::SizeField> expr;
     try {
-      field = optimize::metric_field_from_size_field(m, *expr);
+      expr = o.metric_expr.empty() ? size::make_expression_field(o.size_expr) : parse_metric_expr(o.metric_expr);
+    } catch (const InputError&) {
+      throw;
     } catch (const std::exception& e) {
       throw InputError("--size-expr", -1, -1, e.what());
+    }
+    spec.analytic = std::make_shared<ClampedField>(expr, o.hmin, o.hmax);
+    try {
+      field = optimize::metric_field_from_size_field(m, *spec.analytic);
+    } catch (const std::exception& e) {
+      throw InputError(o.metric_expr.empty() ? "--size-expr" : "--metric-expr", -1, -1, e.what());
     }
   } else if (o.aniso) {
     field = optimize::metric_field_from_mesh_shape(m);
@@ -76,7 +165,7 @@ std::optional<optimize::MetricField> make_metric(const OptimizeCliOptions& o, co
     throw InputError("--hmin/--hmax", -1, -1, e.what());
   }
   optimize::grade(field, m, o.hgrad);
-  return field;
+  return spec;
 }
 
 nlohmann::json summary_json(const optimize::MeshSummary& s, bool metric) {
@@ -101,6 +190,45 @@ nlohmann::json lengths_json(const optimize::LengthStats& l) {
           {"in_0_7_1_4", l.in_range}, {"percent_in_0_7_1_4", l.percent_in_range()},
           {"too_short", l.too_short}, {"too_long", l.too_long},
           {"histogram_bin_0_25", l.histogram}};
+}
+
+nlohmann::json limit_json(const optimize::BoundaryLimit& l) {
+  nlohmann::json worst = nlohmann::json::array();
+  for (const auto& w : l.worst)
+    worst.push_back({{"min_dihedral_deg", w.dihedral},
+                     {"mean_ratio", w.mean_ratio},
+                     {"why", optimize::to_string(w.why)},
+                     {"cap_deg", w.cap},
+                     {"boundary_vertices", w.boundary_verts},
+                     {"boundary_faces", w.boundary_faces},
+                     {"centroid", {w.centroid.x(), w.centroid.y(), w.centroid.z()}}});
+  return {{"target_deg", l.target},
+          {"pinned", l.pinned},
+          {"pinned_by_two_faces", l.by_two_faces},
+          {"pinned_by_wedge", l.by_wedge},
+          {"pinned_min_dihedral_deg", l.pinned_min_dihedral},
+          {"pinned_min_mean_ratio", l.pinned_min_mean_ratio},
+          {"pinned_min_cap_deg", l.pinned_min_cap},
+          {"free_below_target", l.free_below},
+          {"free_min_dihedral_deg", l.free_min_dihedral},
+          {"free_min_mean_ratio", l.free_min_mean_ratio},
+          {"worst", worst}};
+}
+
+std::string render_limit(const optimize::BoundaryLimit& l) {
+  std::string s = fmt::format(
+      "below {:g} deg: {} tets pinned by the boundary ({} with two boundary faces, {} by a boundary wedge)", l.target,
+      l.pinned, l.by_two_faces, l.by_wedge);
+  if (l.pinned)
+    s += fmt::format(": min dihedral {:.2f} deg, min mean ratio {:.4f}, the boundary allows {:.2f} deg at best",
+                     l.pinned_min_dihedral, l.pinned_min_mean_ratio, l.pinned_min_cap);
+  s += fmt::format("; {} free; free tets min dihedral {:.2f} deg, min mean ratio {:.4f}\n", l.free_below,
+                   l.free_min_dihedral, l.free_min_mean_ratio);
+  for (const auto& w : l.worst)
+    s += fmt::format("    {:6.2f} deg  mean ratio {:.4f}  {:<18}  cap {:6.2f} deg  at ({:.6g}, {:.6g}, {:.6g})\n",
+                     w.dihedral, w.mean_ratio, optimize::to_string(w.why), w.cap, w.centroid.x(), w.centroid.y(),
+                     w.centroid.z());
+  return s;
 }
 
 std::string render_lengths(const optimize::LengthStats& l) {
@@ -149,9 +277,9 @@ int run_optimize(const OptimizeCliOptions& o) {
   const double read_s = step.seconds();
 
   step.reset();
-  std::optional<optimize::MetricField> field = make_metric(o, m);
+  std::optional<SizeSpec> spec = make_metric(o, m);
   // Adaptation adds and removes vertices and keeps the field attached to them.
-  const optimize::MetricField* metric = field ? &*field : nullptr;
+  const optimize::MetricField* metric = spec ? &spec->field : nullptr;
   const double metric_s = step.seconds();
   const optimize::MeshSummary before = optimize::summarize_mesh(m, metric);
 
@@ -163,7 +291,8 @@ int run_optimize(const OptimizeCliOptions& o) {
     ao.passes = o.passes;
     ao.threshold = o.threshold;
     ao.model = model.get();
-    adapt = optimize::adapt_to_metric(m, *field, ao);
+    ao.sizes = spec->analytic.get();
+    adapt = optimize::adapt_to_metric(m, spec->field, ao);
   } else {
     optimize::ImproveOptions io_;
     io_.passes = o.passes;
@@ -176,6 +305,9 @@ int run_optimize(const OptimizeCliOptions& o) {
   step.reset();
   const auto check = mesh::validate(m, mesh::Level::kFull);
   const optimize::MeshSummary after = optimize::summarize_mesh(m, metric);
+  // The isotropic angle target the issue sets (10 degrees): which tets the
+  // surface keeps below it.
+  const optimize::BoundaryLimit limit = optimize::classify_boundary_limit(m, 10.0, 5);
   const double check_s = step.seconds();
 
   step.reset();
@@ -233,6 +365,7 @@ int run_optimize(const OptimizeCliOptions& o) {
     j["operators"] = {{"edge_removals", iso.edge_removals},
                       {"face_swaps", iso.face_swaps},
                       {"relocations", iso.relocations},
+                      {"boundary_relocations", iso.boundary_relocations},
                       {"insertions", iso.insertions},
                       {"passes", iso.passes},
                       {"seconds",
@@ -242,6 +375,7 @@ int run_optimize(const OptimizeCliOptions& o) {
     op_seconds = iso.seconds;
   }
   j["boundary"] = boundary_policy(metric != nullptr, model != nullptr);
+  j["boundary_limit"] = limit_json(limit);
   j["seconds"] = {{"read", read_s},         {"metric", metric_s}, {"optimize", optimize_s}, {"check", check_s},
                   {"write", write_s},       {"total", total.seconds()}};
   if (!o.json_path.empty()) write_json(j, o.json_path);
@@ -272,11 +406,12 @@ int run_optimize(const OptimizeCliOptions& o) {
                  adapt.lengths_after.mean);
       fmt::print("{}", render_lengths(adapt.lengths_after));
     } else {
-      fmt::print("operators: {} edge removals, {} face swaps, {} relocations, {} insertions in {} passes (swaps "
+      fmt::print("operators: {} edge removals, {} face swaps, {} relocations ({} on the boundary), {} insertions in {} passes (swaps "
                  "{:.2f} s, relocation {:.2f} s, insertion {:.2f} s)\n",
-                 iso.edge_removals, iso.face_swaps, iso.relocations, iso.insertions, iso.passes, iso.swap_seconds,
+                 iso.edge_removals, iso.face_swaps, iso.relocations, iso.boundary_relocations, iso.insertions, iso.passes, iso.swap_seconds,
                  iso.relocation_seconds, iso.insertion_seconds);
     }
+    fmt::print("{}", render_limit(limit));
     fmt::print("volume: {:.10g} -> {:.10g}; boundary: {}\n", before.volume, after.volume,
                boundary_policy(metric != nullptr, model != nullptr));
     fmt::print("check: {}", ok ? "valid" : "INVALID");
@@ -304,6 +439,11 @@ void add_optimize_command(CLI::App& app, Runner& runner) {
                               "the input's vertices (.sol/.solb)");
   auto* expr = cmd->add_option("--size-expr", o->size_expr, "Size as a function of x, y, z, e.g. '0.1 + 0.05*x'");
   sol->excludes(expr);
+  auto* metric_expr = cmd->add_option(
+      "--metric-expr", o->metric_expr,
+      "Anisotropic metric from three sizes along x, y and z, 'hx; hy; hz' (each as --size-expr)");
+  metric_expr->excludes(sol);
+  metric_expr->excludes(expr);
   cmd->add_option("--hmin", o->hmin, "Smallest size: clamps the size map (alone: the mesh's own sizes)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--hmax", o->hmax, "Largest size: clamps the size map (alone: the mesh's own sizes)")
@@ -332,7 +472,8 @@ void add_optimize_command(CLI::App& app, Runner& runner) {
       "from the mesh's vertices), 3 internal error.\n"
       "Examples:\n  curvemesh optimize part.msh -o part_opt.msh\n"
       "  curvemesh optimize part.mesh --sol sizes.sol -o part_opt.mesh --json report.json\n"
-      "  curvemesh optimize part.mesh --sol metric.sol --aniso -o part_opt.mesh");
+      "  curvemesh optimize part.mesh --sol metric.sol --aniso -o part_opt.mesh\n"
+      "  curvemesh optimize box.msh --metric-expr '0.02 + 0.2*abs(x - 0.5); 0.1; 0.1' -o box_aniso.msh");
   cmd->callback([&runner, o] { runner = [o] { return run_optimize(*o); }; });
 }
 

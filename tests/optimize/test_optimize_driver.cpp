@@ -11,6 +11,7 @@
 
 #include "curvemesh/mesh/validate.hpp"
 #include "curvemesh/optimize/adapt.hpp"
+#include "curvemesh/optimize/boundary_limit.hpp"
 #include "curvemesh/optimize/improve.hpp"
 #include "perturbed_box.hpp"
 
@@ -172,4 +173,34 @@ TEST(AdaptDriver, CoarserSizeMapCollapsesInteriorVertices) {
   // the interior ones are gone.
   EXPECT_LT(st.lengths_after.too_short, st.lengths_before.too_short);
   for (VertId v = 0; v < m.num_verts(); ++v) EXPECT_NE(m.vert2tet[v], kNone);
+}
+
+TEST(BoundaryLimit, SeparatesPinnedFromFreeTets) {
+  // A lone sliver: all four faces on the hull, nothing can change it.
+  mesh::TetMesh m;
+  for (const Vec3& x : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0), Vec3(0.5, 0.4, 0.02)}) m.add_vert(x);
+  m.add_tet({0, 1, 2, 3}, 1);
+  m.resize_vertex_arrays();
+  for (VertId v = 0; v < 4; ++v) m.vert_class[v] = {2, 1};
+  const auto one = classify_boundary_limit(m);
+  EXPECT_EQ(one.pinned, 1u);
+  EXPECT_EQ(one.by_two_faces, 1u);
+  EXPECT_EQ(one.free_below, 0u);
+  EXPECT_EQ(one.free_min_dihedral, 180.0);
+  ASSERT_EQ(one.worst.size(), 1u);
+  EXPECT_EQ(one.worst[0].why, BoundaryLimit::Why::kTwoFaces);
+  EXPECT_EQ(one.worst[0].boundary_faces, 4);
+  EXPECT_NEAR(one.pinned_min_dihedral, summarize_mesh(m).min_dihedral, 1e-12);
+
+  // The flattened box: its slivers are inside, so they are free, and the
+  // two minima together are the mesh's.
+  auto box = test::perturbed_box(5, 2, 0.45, 12);
+  const auto s = summarize_mesh(box);
+  const auto l = classify_boundary_limit(box);
+  EXPECT_GT(l.free_below, 0u);
+  EXPECT_NEAR(std::min(l.pinned_min_dihedral, l.free_min_dihedral), s.min_dihedral, 1e-9);
+  EXPECT_NEAR(std::min(l.pinned_min_mean_ratio, l.free_min_mean_ratio), s.min_mean_ratio, 1e-12);
+  ASSERT_FALSE(l.worst.empty());
+  EXPECT_NEAR(l.worst[0].dihedral, s.min_dihedral, 1e-9);
+  for (std::size_t i = 1; i < l.worst.size(); ++i) EXPECT_LE(l.worst[i - 1].dihedral, l.worst[i].dihedral);
 }

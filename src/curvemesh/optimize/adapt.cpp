@@ -19,6 +19,7 @@
 #include "curvemesh/modify/relocate.hpp"
 #include "curvemesh/modify/split.hpp"
 #include "curvemesh/modify/swap.hpp"
+#include "curvemesh/optimize/measured_swap.hpp"
 #include "curvemesh/optimize/shell_insert.hpp"
 #include "curvemesh/quality/measures.hpp"
 
@@ -35,45 +36,33 @@ double min_metric_quality(const mesh::TetMesh& m, const MetricField& f, std::spa
   return q;
 }
 
-double min_metric_quality(const mesh::TetMesh& m, const MetricField& f, std::span<const modify::NewTet> fill) {
-  double q = 1;
-  for (const auto& nt : fill) q = std::min(q, f.tet_quality(m, nt.verts));
-  return q;
+double metric_measure(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void* field) {
+  return static_cast<const MetricField*>(field)->tet_quality(m, v);
 }
 
-// The metric quality a reconnection plan would give, or -1 when it has no
-// valid fill. The planner leaves its cavity in `cav`.
-double metric_gain(const mesh::TetMesh& m, const MetricField& f, const modify::Cavity& cav, const modify::Plan& p,
-                   double& before) {
-  if (p.fill.empty() || !(p.after > 0)) return -1;
-  before = min_metric_quality(m, f, cav.tets());
-  return min_metric_quality(m, f, p.fill);
-}
-
+// The best reconnection of t in the metric: edge removal whose ring
+// triangulation is chosen in the metric, or a 2-3 face swap.
 bool reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f, TetId t, AdaptStats& st) {
   const auto& m = ed.mesh();
   int kind = -1, local = 0;
   double best_gain = kMargin;
   const auto tv = m.tet2verts[t];
   auto consider = [&](const modify::Plan& p, int k, int l) {
-    // Refused for isotropic quality may still be better in the metric;
-    // refused for validity or constraints is final.
-    if (p.refusal != modify::Refusal::kNone && p.refusal != modify::Refusal::kNoImprovement) return;
-    double before = 0;
-    const double after = metric_gain(m, f, cav, p, before);
-    if (after > 0 && after - before > best_gain) {
-      best_gain = after - before;
+    if (p.refusal == modify::Refusal::kNone && p.after - p.before > best_gain) {
+      best_gain = p.after - p.before;
       kind = k;
       local = l;
     }
   };
   for (int e = 0; e < 6; ++e)
-    consider(modify::plan_edge_removal(ed, cav, tv[mesh::kTetEdges[e][0]], tv[mesh::kTetEdges[e][1]], t), 0, e);
-  for (int fi = 0; fi < 4; ++fi) consider(modify::plan_face_swap(ed, cav, t, fi), 1, fi);
+    consider(plan_measured_edge_removal(ed, cav, tv[mesh::kTetEdges[e][0]], tv[mesh::kTetEdges[e][1]], t,
+                                        metric_measure, &f),
+             0, e);
+  for (int fi = 0; fi < 4; ++fi) consider(plan_measured_face_swap(ed, cav, t, fi, metric_measure, &f), 1, fi);
   if (kind < 0) return false;
-  const auto p = kind == 0 ? modify::plan_edge_removal(ed, cav, tv[mesh::kTetEdges[local][0]],
-                                                       tv[mesh::kTetEdges[local][1]], t)
-                           : modify::plan_face_swap(ed, cav, t, local);
+  const auto p = kind == 0 ? plan_measured_edge_removal(ed, cav, tv[mesh::kTetEdges[local][0]],
+                                                        tv[mesh::kTetEdges[local][1]], t, metric_measure, &f)
+                           : plan_measured_face_swap(ed, cav, t, local, metric_measure, &f);
   modify::apply(ed, cav, p);
   ++(kind == 0 ? st.edge_removals : st.face_swaps);
   return true;
@@ -144,6 +133,20 @@ bool relocate(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f,
   if (!(r.after > r.before + kMargin)) return false;
   modify::apply(ed, cav, v, r);
   return true;
+}
+
+// With the analytic field the metric came from, a new or moved vertex takes
+// its exact value: interpolating between the ends of a coarse edge across a
+// shock would blur the very feature the size map asks for.
+void refresh(MetricField& f, const AdaptOptions& o, const mesh::TetMesh& m, VertId v) {
+  if (!o.sizes) return;
+  const Vec3& x = m.coords[v];
+  if (f.anisotropic()) {
+    f.set(v, o.sizes->metric(x));
+  } else {
+    const double h = o.sizes->size(x);
+    f.set(v, size::Metric::Identity() / (h * h));
+  }
 }
 
 // A split or collapse may leave tets this poor: the shape pass that follows
@@ -226,6 +229,7 @@ std::size_t split_long_edges(modify::MeshEditor& ed, modify::Cavity& cav, modify
     if (q < kMinNewQuality) continue;
     const VertId p = modify::apply(ed, cav, boundary, plan);
     f.set_interpolated(p, e.a, e.b, 0.5);
+    refresh(f, o, m, p);
     ++done;
   }
   return done;
@@ -406,6 +410,7 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
           if (!relocate(ed, cav, field, v, ball, ring) &&
               !relocate_on_model(ed, cav, boundary, o.model, field, v, ball))
             continue;
+          refresh(field, o, m, v);
           ++st.relocations;
           moved = true;
           if (ed.is_dead(t)) break;  // rebuilt: its other vertices are in new tets
@@ -434,6 +439,7 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
           const VertId a = tv[mesh::kTetEdges[best][0]], b = tv[mesh::kTetEdges[best][1]];
           const VertId p = apply(ed, cav, plan_shell_insertion(ed, cav, a, b, t));
           field.set_interpolated(p, a, b, 0.5);
+          refresh(field, o, m, p);
           ++st.insertions;
           ++changes;
         }

@@ -13,10 +13,11 @@
 // six edges, 2-3 swap on its four faces), else relocation of its vertices
 // toward the position that is best in the metric (boundary ones only with a
 // model, on it), else for an isotropic field a new point in the shell of
-// one of its interior edges (shell_insert.hpp). The swap
-// planners choose their triangulation by the isotropic mean ratio; the
-// driver re-measures every candidate in the metric and keeps only those
-// that raise the worst metric quality of what they replace. A new vertex
+// one of its interior edges (shell_insert.hpp). Edge removal chooses its
+// ring triangulation by the metric quality itself (measured_swap.hpp), so
+// in a stretched metric it finds the reconnections the isotropic measure
+// would rank low; a swap is kept only when it raises the worst metric
+// quality of what it replaces. A new vertex
 // gets the log-Euclidean interpolation of its edge's end metrics.
 //
 // The boundary. Without a model, boundary vertices never move nor go: a
@@ -33,6 +34,7 @@
 #include "curvemesh/geom/model.hpp"
 #include "curvemesh/mesh/tet_mesh.hpp"
 #include "curvemesh/optimize/metric_field.hpp"
+#include "curvemesh/size/size_field.hpp"
 
 namespace cm::optimize {
 
@@ -50,6 +52,12 @@ struct AdaptOptions {
   bool insertion = true;
   /// The CAD model the mesh is classified on, or nullptr (boundary kept).
   const geom::Model* model = nullptr;
+  /// The analytic size or metric the field was sampled from, or nullptr.
+  /// When given, vertices made by a split or an insertion and vertices
+  /// relocated take its value at their position (its metric() when the
+  /// field is anisotropic, else I/size²) instead of the log-Euclidean
+  /// interpolation of their neighbours'. Must be thread-safe.
+  const size::SizeField* sizes = nullptr;
 };
 
 struct AdaptStats {

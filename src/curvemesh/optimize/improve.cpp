@@ -2,14 +2,18 @@
 
 #include <algorithm>
 #include <memory>
+#include <span>
+#include <utility>
 
 #include "curvemesh/core/timer.hpp"
+#include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
 #include "curvemesh/modify/marks.hpp"
 #include "curvemesh/modify/measure.hpp"
 #include "curvemesh/modify/relocate.hpp"
 #include "curvemesh/modify/surface.hpp"
 #include "curvemesh/modify/swap.hpp"
+#include "curvemesh/optimize/measured_swap.hpp"
 #include "curvemesh/optimize/shell_insert.hpp"
 #include "curvemesh/quality/measures.hpp"
 
@@ -48,46 +52,80 @@ bool needs_work(const mesh::TetMesh& m, TetId t, double q, const ImproveOptions&
   return q < o.threshold || min_dihedral(m, t) < o.dihedral_threshold;
 }
 
-// The best reconnection of tet t: which operator, on what, and how good.
-struct Choice {
-  int kind = -1;  // 0 edge removal, 1 face swap
-  int local = 0;  // edge or face index in t
-  double after = 0;
-};
+double shape(const mesh::TetMesh& m, TetId t) { return angle_aware_measure(m, m.tet2verts[t], nullptr); }
 
+// Worst mean ratio and worst angle-aware quality of a set of tets.
+void take_worst(const mesh::TetMesh& m, const std::array<VertId, 4>& v, std::pair<double, double>& w) {
+  w.first = std::min(w.first, modify::tet_quality(m, v));
+  w.second = std::min(w.second, angle_aware_measure(m, v, nullptr));
+}
+std::pair<double, double> worst_of(const mesh::TetMesh& m, std::span<const TetId> tets) {
+  std::pair<double, double> w{1, 1};
+  for (TetId t : tets) take_worst(m, m.tet2verts[t], w);
+  return w;
+}
+std::pair<double, double> worst_of(const mesh::TetMesh& m, std::span<const modify::NewTet> fill) {
+  std::pair<double, double> w{1, 1};
+  for (const auto& nt : fill) take_worst(m, nt.verts, w);
+  return w;
+}
+
+// The best reconnection of t: for each of its edges the ring triangulation
+// best for the angle-aware measure and the one best for the mean ratio, and
+// the 2-3 swap of each face; progress as is_progress() says, the highest
+// resulting angle-aware quality (then mean ratio) wins.
 bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, ImproveStats& st) {
   const auto& m = ed.mesh();
-  Choice best;
-  best.after = modify::tet_quality(m, m.tet2verts[t]);
+  int kind = -1, local = 0;
+  std::pair<double, double> best{-1, -1};  // (shape, mean ratio) after
   const auto tv = m.tet2verts[t];
-  for (int e = 0; e < 6; ++e) {
-    const auto p = modify::plan_edge_removal(ed, cav, tv[mesh::kTetEdges[e][0]], tv[mesh::kTetEdges[e][1]], t);
-    if (p.improves() && p.after > best.after) best = {0, e, p.after};
-  }
-  for (int f = 0; f < 4; ++f) {
-    const auto p = modify::plan_face_swap(ed, cav, t, f);
-    if (p.improves() && p.after > best.after) best = {1, f, p.after};
-  }
-  if (best.kind < 0) return false;
+  auto plan = [&](int k, int l) {
+    const VertId a = tv[mesh::kTetEdges[l % 6][0]], b = tv[mesh::kTetEdges[l % 6][1]];
+    switch (k) {
+      case 0: return plan_measured_edge_removal(ed, cav, a, b, t, angle_aware_measure, nullptr);
+      case 1: return modify::plan_edge_removal(ed, cav, a, b, t);
+      default: return modify::plan_face_swap(ed, cav, t, l);
+    }
+  };
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < (k < 2 ? 6 : 4); ++l) {
+      const modify::Plan p = plan(k, l);
+      if (p.fill.empty() || !(p.after > 0)) continue;
+      const auto [mr_b, sh_b] = worst_of(m, cav.tets());
+      const auto [mr_a, sh_a] = worst_of(m, p.fill);
+      if (!is_progress(mr_b, sh_b, mr_a, sh_a) || std::pair{sh_a, mr_a} <= best) continue;
+      best = {sh_a, mr_a};
+      kind = k;
+      local = l;
+    }
+  if (kind < 0) return false;
   // Plan again (the cavity was reused by the other candidates) and apply.
-  const auto p = best.kind == 0 ? modify::plan_edge_removal(ed, cav, tv[mesh::kTetEdges[best.local][0]],
-                                                           tv[mesh::kTetEdges[best.local][1]], t)
-                                : modify::plan_face_swap(ed, cav, t, best.local);
-  modify::apply(ed, cav, p);
-  ++(best.kind == 0 ? st.edge_removals : st.face_swaps);
+  modify::apply(ed, cav, plan(kind, local));
+  ++(kind < 2 ? st.edge_removals : st.face_swaps);
   return true;
 }
 
 // With a model, boundary vertices move too, on their model entity.
 bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::BoundaryIndex* boundary,
-                  const geom::Model* model, TetId t, ImproveStats& st) {
+                  const geom::Model* model, TetId t, ImproveStats& st, std::vector<TetId>& ball) {
   bool moved = false;
-  const auto tv = ed.mesh().tet2verts[t];
+  auto& m = ed.mesh();
+  const auto tv = m.tet2verts[t];
   for (VertId v : tv) {
     const auto r = model ? modify::plan_relocation(ed, cav, *boundary, v, model) : modify::plan_relocation(ed, cav, v);
     if (r.refusal != modify::Refusal::kNone) continue;
+    // The planner raises the ball's worst mean ratio; a move that does so by
+    // flattening a sliver elsewhere in the ball is no progress.
+    mesh::collect_ball(m, v, ball);
+    const auto before = worst_of(m, ball);
+    const Vec3 old = m.coords[v];
+    m.coords[v] = r.target;
+    const auto after = worst_of(m, ball);
+    m.coords[v] = old;
+    if (!is_progress(before.first, before.second, after.first, after.second)) continue;
     modify::apply(ed, cav, v, r);
     ++st.relocations;
+    st.boundary_relocations += m.vert_class[v].dim < 3;
     moved = true;
     if (ed.is_dead(t)) break;  // t was rebuilt: its other vertices are in new tets
   }
@@ -133,12 +171,15 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
   st.below_before = before.below;
   st.min_dihedral_before = before.min_dihedral;
   std::vector<std::pair<double, TetId>> bad;
+  std::vector<TetId> ball;
   for (st.passes = 0; st.passes < o.passes; ++st.passes) {
     bad.clear();
     for (TetId t = 0; t < m.tet2verts.size(); ++t) {
       if (ed.is_dead(t)) continue;
       const double q = modify::tet_quality(m, m.tet2verts[t]);
-      if (needs_work(m, t, q, o)) bad.emplace_back(q, t);
+      // Worst angle-aware shape first: slivers before fair-angled tets of
+      // the same mean ratio.
+      if (needs_work(m, t, q, o)) bad.emplace_back(shape(m, t), t);
     }
     if (bad.empty()) break;
     std::sort(bad.begin(), bad.end());
@@ -156,7 +197,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
       }
       if (o.relocation) {
         Timer op;
-        const bool moved = try_relocate(ed, cav, boundary.get(), o.model, t, st);
+        const bool moved = try_relocate(ed, cav, boundary.get(), o.model, t, st, ball);
         st.relocation_seconds += op.seconds();
         if (moved) {
           ++changes;

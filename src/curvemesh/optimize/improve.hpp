@@ -1,7 +1,8 @@
 #pragma once
 // Isotropic shape improvement (paper 2, first case): the worst tets first,
 // each tried with edge removal on its six edges and the 2-3 swap on its four
-// faces (the best improving reconnection wins), then relocation of its
+// faces (the best improving reconnection wins, ranked by the mean ratio
+// capped by the smallest dihedral angle: measured_swap.hpp), then relocation of its
 // interior vertices, else a new interior point replacing the shell of one
 // of its interior edges (shell_insert.hpp: the fix for slivers whose
 // vertices are all on the boundary); repeated over a few passes until
@@ -38,6 +39,8 @@ struct ImproveOptions {
 
 struct ImproveStats {
   std::size_t edge_removals = 0, face_swaps = 0, relocations = 0, insertions = 0;
+  /// Of the relocations, those of boundary vertices (on the model).
+  std::size_t boundary_relocations = 0;
   int passes = 0;
   double min_before = 0, mean_before = 0, min_after = 0, mean_after = 0;
   /// Smallest dihedral angle over the mesh, degrees.

@@ -1,24 +1,39 @@
 #include "curvemesh/optimize/shell_insert.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
-#include "curvemesh/modify/measure.hpp"
 #include "curvemesh/modify/surface.hpp"
+#include "curvemesh/optimize/measured_swap.hpp"
 
 namespace cm::optimize {
 
 namespace {
 
-// Worst quality of the star of x over the cavity boundary. A boundary face
-// lists its vertices with the normal out of the cavity, so the new tet has
-// x behind it: (f1, f0, f2, x) is the positive order.
-double star_quality(const mesh::TetMesh& m, std::span<const modify::CavityFace> faces, const Vec3& x) {
-  double q = 1;
+// Worst mean ratio and worst angle-aware quality of the star of x over the
+// cavity boundary. A boundary face lists its vertices with the normal out of
+// the cavity, so the new tet has x behind it: (f1, f0, f2, x) is the
+// positive order.
+std::pair<double, double> star_quality(const mesh::TetMesh& m, std::span<const modify::CavityFace> faces,
+                                       const Vec3& x) {
+  std::pair<double, double> q{1, 1};
   for (const auto& f : faces) {
-    q = std::min(q, modify::tet_quality_at(m.coords[f.verts[1]], m.coords[f.verts[0]], m.coords[f.verts[2]], x));
-    if (q <= 0) return q;
+    const Vec3 &a = m.coords[f.verts[1]], &b = m.coords[f.verts[0]], &c = m.coords[f.verts[2]];
+    q.second = std::min(q.second, angle_aware_quality(a, b, c, x));
+    if (q.second <= 0) return {-1, -1};
+    q.first = std::min(q.first, modify::tet_quality_at(a, b, c, x));
+  }
+  return q;
+}
+
+std::pair<double, double> worst_shape(const mesh::TetMesh& m, std::span<const TetId> tets) {
+  std::pair<double, double> q{1, 1};
+  for (TetId t : tets) {
+    q.first = std::min(q.first, modify::tet_quality_at(m.coords[m.tet2verts[t][0]], m.coords[m.tet2verts[t][1]],
+                                                       m.coords[m.tet2verts[t][2]], m.coords[m.tet2verts[t][3]]));
+    q.second = std::min(q.second, angle_aware_measure(m, m.tet2verts[t], nullptr));
   }
   return q;
 }
@@ -30,33 +45,38 @@ Vec3 star_centroid(const mesh::TetMesh& m, std::span<const modify::CavityFace> f
   return c / static_cast<double>(faces.size());
 }
 
-// Chooses the point for a cavity whose worst quality is plan.before: the
-// given guess, the centroid of the boundary's vertices and their middle,
-// each smoothed while that helps; sets after, point and the refusal.
+// Chooses the point for a cavity whose worst (mean ratio, angle-aware
+// quality) is `before`: the given guess, the centroid of the boundary's
+// vertices and their middle, each smoothed while its angle-aware quality
+// rises; the best that is progress (is_progress) wins. Sets after (the
+// angle-aware quality), point and the refusal.
 void place_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> faces, const Vec3& guess,
-                 ShellInsertion& plan) {
+                 std::pair<double, double> before, ShellInsertion& plan) {
   Vec3 centroid = Vec3::Zero();
   for (const auto& f : faces) centroid += m.coords[f.verts[0]] + m.coords[f.verts[1]] + m.coords[f.verts[2]];
   centroid /= 3.0 * static_cast<double>(faces.size());
+  plan.before = before.second;
   plan.after = -1;
+  bool positive = false;
   for (const Vec3& start : {guess, centroid, Vec3(0.5 * (guess + centroid))}) {
     Vec3 x = start;
-    double q = star_quality(m, faces, x);
+    auto q = star_quality(m, faces, x);
     for (int it = 0; it < 4; ++it) {
       const Vec3 y = star_centroid(m, faces, x);
-      const double qy = star_quality(m, faces, y);
-      if (!(qy > q)) break;
+      const auto qy = star_quality(m, faces, y);
+      if (!(qy.second > q.second)) break;
       x = y;
       q = qy;
     }
-    if (q > plan.after) {
-      plan.after = q;
+    positive |= q.second > 0;
+    if (q.second > plan.after && is_progress(before.first, before.second, q.first, q.second)) {
+      plan.after = q.second;
       plan.point = x;
     }
   }
-  if (!(plan.after > 0))
+  if (!positive)
     plan.refusal = modify::Refusal::kNotStarShaped;
-  else if (!(plan.after > plan.before + 1e-6))
+  else if (!(plan.after > 0))
     plan.refusal = modify::Refusal::kNoImprovement;
 }
 
@@ -88,8 +108,7 @@ ShellInsertion plan_shell_insertion(modify::MeshEditor& ed, modify::Cavity& cav,
       }
     cav.add(ed, t);
   }
-  plan.before = modify::min_quality(m, shell.tets);
-  place_point(m, cav.compute_boundary(ed), 0.5 * (m.coords[a] + m.coords[b]), plan);
+  place_point(m, cav.compute_boundary(ed), 0.5 * (m.coords[a] + m.coords[b]), worst_shape(m, shell.tets), plan);
   return plan;
 }
 
@@ -119,10 +138,9 @@ ShellInsertion plan_ball_insertion(modify::MeshEditor& ed, modify::Cavity& cav, 
     plan.refusal = modify::Refusal::kConstrainedFace;
     return plan;
   }
-  plan.before = modify::min_quality(m, cav.tets());
   Vec3 centroid = Vec3::Zero();
   for (VertId v : m.tet2verts[t]) centroid += m.coords[v] / 4;
-  place_point(m, cav.boundary(), centroid, plan);
+  place_point(m, cav.boundary(), centroid, worst_shape(m, cav.tets()), plan);
   return plan;
 }
 

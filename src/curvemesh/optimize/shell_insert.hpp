@@ -18,7 +18,8 @@ struct ShellInsertion {
   modify::Refusal refusal = modify::Refusal::kNone;
   VertId a = kNone, b = kNone;
   Vec3 point = Vec3::Zero();
-  /// Worst modify::tet_quality of the shell, and of the star that replaces it.
+  /// Worst angle_aware_quality (measured_swap.hpp) of the shell, and of the
+  /// star that replaces it: the point is placed for the angles too.
   double before = 0, after = 0;
 };
 

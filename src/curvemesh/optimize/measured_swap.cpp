@@ -1,0 +1,159 @@
+#include "curvemesh/optimize/measured_swap.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include "curvemesh/core/predicates.hpp"
+#include "curvemesh/mesh/adjacency.hpp"
+#include "curvemesh/mesh/topology.hpp"
+#include "curvemesh/quality/measures.hpp"
+
+namespace cm::optimize {
+
+double angle_aware_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return -1;
+  constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
+  const double angle = quality::tet_dihedral_range(a, b, c, d).min / kRegularDihedral;
+  return std::max(std::min(quality::tet_mean_ratio(a, b, c, d), angle), 0.0);
+}
+
+bool is_progress(double mr_before, double shape_before, double mr_after, double shape_after) {
+  constexpr double kFloor = 0.2, kMargin = 1e-6;
+  if (!(mr_after > 0) || !(shape_after > 0)) return false;
+  return (shape_after > shape_before + kMargin && mr_after >= std::min(mr_before, kFloor)) ||
+         (mr_after > mr_before + kMargin && shape_after >= std::min(shape_before, kFloor));
+}
+
+double angle_aware_measure(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void*) {
+  return angle_aware_quality(m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]);
+}
+
+modify::Plan plan_measured_edge_removal(modify::MeshEditor& ed, modify::Cavity& cav, VertId a, VertId b, TetId start,
+                                        TetMeasure measure, const void* context) {
+  using modify::Refusal;
+  constexpr int kMax = modify::kMaxShell;
+  const auto& m = ed.mesh();
+  modify::Plan plan;
+  thread_local mesh::Shell shell;
+  shell = mesh::collect_shell(m, a, b, start);
+  const int n = static_cast<int>(shell.tets.size());
+  if (!shell.closed) {
+    plan.refusal = Refusal::kConstrainedFace;
+    return plan;
+  }
+  if (n < 3 || n > kMax) {
+    plan.refusal = Refusal::kNoImprovement;
+    return plan;
+  }
+  const std::int32_t region = m.tet_region[shell.tets[0]];
+  cav.reset(ed);
+  plan.before = 1;
+  for (TetId t : shell.tets) {
+    if (m.tet_region[t] != region) {
+      plan.refusal = Refusal::kClassification;
+      return plan;
+    }
+    const int ia = mesh::local_index(m, t, a), ib = mesh::local_index(m, t, b);
+    for (int f = 0; f < 4; ++f)
+      if (f != ia && f != ib && ed.face_marked(mesh::pack_face(t, f))) {
+        plan.refusal = Refusal::kConstrainedFace;
+        return plan;
+      }
+    cav.add(ed, t);
+    plan.before = std::min(plan.before, measure(m, m.tet2verts[t], context));
+  }
+  // ring[k] is shared by shell tets k-1 and k.
+  std::array<VertId, kMax> ring{};
+  auto others = [&](TetId t) {
+    std::array<VertId, 2> o{kNone, kNone};
+    int k = 0;
+    for (VertId v : m.tet2verts[t])
+      if (v != a && v != b) o[k++] = v;
+    return o;
+  };
+  for (int k = 0; k < n; ++k) {
+    const auto p = others(shell.tets[static_cast<std::size_t>(k)]);
+    const auto q = others(shell.tets[static_cast<std::size_t>((k + n - 1) % n)]);
+    ring[static_cast<std::size_t>(k)] = (p[0] == q[0] || p[0] == q[1]) ? p[0] : p[1];
+  }
+  // Seen from a the ring turns positively when orient3d(a, b, r0, r1) < 0;
+  // then (ri, rj, rk, a) is positive for i < j < k.
+  const bool ccw_from_a = predicates::orient3d(m.coords[a].data(), m.coords[b].data(), m.coords[ring[0]].data(),
+                                               m.coords[ring[1]].data()) < 0;
+  auto tets_of = [&](int i, int j, int k) {
+    const VertId ri = ring[static_cast<std::size_t>(i)], rj = ring[static_cast<std::size_t>(j)],
+                 rk = ring[static_cast<std::size_t>(k)];
+    return ccw_from_a ? std::array<std::array<VertId, 4>, 2>{{{ri, rj, rk, a}, {rj, ri, rk, b}}}
+                      : std::array<std::array<VertId, 4>, 2>{{{rj, ri, rk, a}, {ri, rj, rk, b}}};
+  };
+  // A triangle (i, k, j) of the ring appears in many sub-polygons: measure
+  // its two tets once.
+  constexpr double kUnset = -std::numeric_limits<double>::infinity();
+  double tri[kMax][kMax][kMax];
+  for (int i = 0; i < n; ++i)
+    for (int k = i + 1; k < n; ++k)
+      for (int j = k + 1; j < n; ++j) tri[i][k][j] = kUnset;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double best[kMax][kMax];
+  int pick[kMax][kMax];
+  for (int i = 0; i + 1 < n; ++i) best[i][i + 1] = kInf;
+  for (int len = 2; len < n; ++len)
+    for (int i = 0; i + len < n; ++i) {
+      const int j = i + len;
+      best[i][j] = -kInf;
+      pick[i][j] = -1;
+      for (int k = i + 1; k < j; ++k) {
+        const double side = std::min(best[i][k], best[k][j]);
+        if (side <= best[i][j]) continue;
+        double& t2 = tri[i][k][j];
+        if (t2 == kUnset) {
+          const auto tv = tets_of(i, k, j);
+          t2 = std::min(measure(m, tv[0], context), measure(m, tv[1], context));
+        }
+        const double q = std::min(side, t2);
+        if (q > best[i][j]) {
+          best[i][j] = q;
+          pick[i][j] = k;
+        }
+      }
+    }
+  plan.after = best[0][n - 1];
+  if (!(plan.after > 0)) {
+    plan.refusal = Refusal::kNotStarShaped;
+    return plan;
+  }
+  std::array<std::pair<int, int>, kMax> stack{};
+  int top = 0;
+  stack[top++] = {0, n - 1};
+  while (top > 0) {
+    const auto [i, j] = stack[--top];
+    if (j - i < 2) continue;
+    const int k = pick[i][j];
+    for (const auto& tv : tets_of(i, k, j)) plan.fill.push_back({tv, region});
+    stack[top++] = {i, k};
+    stack[top++] = {k, j};
+  }
+  if (plan.after <= plan.before) plan.refusal = Refusal::kNoImprovement;
+  return plan;
+}
+
+modify::Plan plan_measured_face_swap(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, int f, TetMeasure measure,
+                                     const void* context) {
+  const auto& m = ed.mesh();
+  modify::Plan plan = modify::plan_face_swap(ed, cav, t, f);
+  // Refused for the isotropic measure may still be better in this one;
+  // refused for validity or constraints is final.
+  if (plan.fill.empty() || plan.refusal == modify::Refusal::kNotStarShaped) return plan;
+  plan.refusal = modify::Refusal::kNone;
+  plan.before = 1;
+  for (TetId u : cav.tets()) plan.before = std::min(plan.before, measure(m, m.tet2verts[u], context));
+  plan.after = 1;
+  for (const auto& nt : plan.fill) plan.after = std::min(plan.after, measure(m, nt.verts, context));
+  if (!(plan.after > 0))
+    plan.refusal = modify::Refusal::kNotStarShaped;
+  else if (plan.after <= plan.before)
+    plan.refusal = modify::Refusal::kNoImprovement;
+  return plan;
+}
+
+}  // namespace cm::optimize

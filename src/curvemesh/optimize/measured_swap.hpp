@@ -1,0 +1,53 @@
+#pragma once
+// Edge removal that chooses its triangulation by a quality the caller gives
+// (the metric mean ratio in anisotropic adaptation, an angle-aware measure
+// in shape improvement). modify::plan_edge_removal picks the ring
+// triangulation that is best for the isotropic mean ratio, which in a
+// stretched metric is often not the best one, and one that is not even
+// better than the shell in the metric gets re-measured and dropped by the
+// driver; here the dynamic program itself maximizes the caller's measure.
+//
+// Same admissibility as modify::plan_edge_removal: closed shell of 3 to
+// modify::kMaxShell tets in one region, no marked face through the edge,
+// every new tet strictly positive by exact orient3d (the measure must
+// return a value <= 0 for a tet that is not).
+#include <array>
+
+#include "curvemesh/modify/swap.hpp"
+
+namespace cm::optimize {
+
+/// Quality of a would-be tet given by its vertices: > 0 for a strictly
+/// positive tet, higher is better; <= 0 when not strictly positive.
+using TetMeasure = double (*)(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void* context);
+
+/// The shape measure of isotropic improvement: the mean ratio, or the
+/// smallest dihedral angle scaled so a regular tet scores 1
+/// (θ_min / acos(1/3)), whichever is lower; -1 unless strictly positive by
+/// exact orient3d. A sliver can keep a fair mean ratio with a tiny angle;
+/// ranking by both makes the angle count where it is the problem.
+double angle_aware_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+/// angle_aware_quality of mesh vertices, as a TetMeasure (context unused).
+double angle_aware_measure(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void* context);
+
+/// Whether replacing tets whose worst mean ratio and worst angle-aware
+/// quality are (mr_before, shape_before) by tets with (mr_after,
+/// shape_after) is progress: one of the two rises and the other does not
+/// fall below the lower of its old value and a floor (0.2 for both: a mean
+/// ratio that no one calls poor; θ_min ≈ 14°). Ranking by the angle alone
+/// trades mean ratio away for spindles (fair angles, tiny volume), by the
+/// mean ratio alone leaves slivers that keep a fair one.
+bool is_progress(double mr_before, double shape_before, double mr_after, double shape_after);
+
+/// Plans the removal of edge (a, b) of live tet `start`, maximizing the
+/// worst `measure` of the new tets; plan.before / after are in that
+/// measure. Fills the cavity with the shell; changes nothing. Apply with
+/// modify::apply(ed, cavity, plan). O(n³) measure calls for a shell of n.
+modify::Plan plan_measured_edge_removal(modify::MeshEditor& ed, modify::Cavity& cavity, VertId a, VertId b,
+                                        TetId start, TetMeasure measure, const void* context);
+
+/// The 2-3 swap of face f of t, measured the same way.
+modify::Plan plan_measured_face_swap(modify::MeshEditor& ed, modify::Cavity& cavity, TetId t, int f,
+                                     TetMeasure measure, const void* context);
+
+}  // namespace cm::optimize
