@@ -35,6 +35,30 @@ bool cross(std::span<const Vec3> x, const std::array<VertId, 3>& p, const std::a
         sq = j;
       }
   if (shared >= 2) return false;
+  // Floating-point plane tests first (the exact predicates below cost a lot
+  // on the many coplanar neighbours of a CAD surface mesh): a triangle with
+  // all the other's vertices clearly on one side of its plane cannot cross
+  // it, and two triangles within rounding of one plane are taken as touching
+  // (a crossing at an angle below ~1e-10 is not something any mesh can fix).
+  auto side_test = [&](const std::array<VertId, 3>& s, const std::array<VertId, 3>& t) {
+    const Vec3 n = (x[s[1]] - x[s[0]]).cross(x[s[2]] - x[s[0]]);
+    double len = 0;
+    for (int i = 0; i < 3; ++i) len = std::max(len, (x[t[i]] - x[s[0]]).norm());
+    const double tol = 1e-10 * n.norm() * len;
+    int pos = 0, neg = 0;
+    for (VertId v : t) {
+      const double d = n.dot(x[v] - x[s[0]]);
+      pos += d > tol;
+      neg += d < -tol;
+    }
+    const bool shares = shared == 1;  // the shared vertex is on both planes
+    if (pos == 3 - shares || neg == 3 - shares) return 1;  // one side: apart
+    if (pos == 0 && neg == 0) return 0;                     // coplanar: touching at most
+    return -1;                                              // undecided
+  };
+  const int sp_side = side_test(p, q);
+  if (sp_side >= 0) return false;
+  if (side_test(q, p) >= 0) return false;
   auto edge_hits = [&](const std::array<VertId, 3>& s, int i, const std::array<VertId, 3>& t) {
     return segment_crosses(x[s[i]], x[s[(i + 1) % 3]], x[t[0]], x[t[1]], x[t[2]]);
   };
