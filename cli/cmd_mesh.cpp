@@ -151,7 +151,13 @@ int run_volume(const MeshCliOptions& o) {
   generate::VolumeMeshStats st;
   mesh::TetMesh m = generate::mesh_volume(*model, *sf.field, {}, &st);
   optimize::ImproveStats opt;
-  if (!o.no_optimize) opt = optimize::improve_quality(m);
+  if (!o.no_optimize) {
+    // With the model, boundary vertices move on it: the worst tets of a
+    // fresh mesh are mostly against the boundary, pinned there otherwise.
+    optimize::ImproveOptions io;
+    io.model = model;
+    opt = optimize::improve_quality(m, io);
+  }
   step.reset();
   const auto valid = mesh::validate(m, mesh::Level::kFull);
   const generate::BoundaryReport rep = generate::check_boundary(*model, m, *sf.field);

@@ -9,7 +9,10 @@
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepAlgoAPI_Fuse.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepCheck_Analyzer.hxx>
+#include <BRepFilletAPI_MakeChamfer.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCone.hxx>
@@ -18,12 +21,16 @@
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
 #include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
 #include <GeomAPI_PointsToBSplineSurface.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Precision.hxx>
 #include <Standard_Failure.hxx>
 #include <TColgp_Array2OfPnt.hxx>
+#include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopTools_ListOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <gp_Ax2.hxx>
@@ -66,6 +73,22 @@ const std::vector<Builtin>& builtins() {
       {"inclusion",
        "two regions: a sphere of radius r inside the cube [-s/2,s/2]^3, and the rest of the cube",
        {{"s", 2}, {"r", 0.5}}},
+      {"thinwall",
+       "thin-walled tube on the z axis from z = 0 to h: outer radius r, wall thickness t < r",
+       {{"r", 1}, {"t", 0.02}, {"h", 2}}},
+      {"holes",
+       "plate [0,s] x [0,s] x [0,h] with an n x n grid of through holes of radius r, one "
+       "centred in each cell (2r < s/n)",
+       {{"n", 6}, {"s", 1}, {"h", 0.2}, {"r", 0.05}}},
+      {"tangent",
+       "near-tangent faces: the box [0,2] x [0,1] x [0,1] fused with a cylinder of radius r "
+       "along x (x in [0.5,1.5], y = 0.5) sunk d into its top face; the surfaces meet at "
+       "about sqrt(2d/r) radians",
+       {{"r", 0.3}, {"d", 0.001}}},
+      {"smalledges",
+       "small edges: the cube [0,s]^3 with a chamfer of width e on one top edge, a step of "
+       "height e across a third of its top and a notch cube of side e at a bottom corner",
+       {{"s", 1}, {"e", 0.001}}},
   };
   return kBuiltins;
 }
@@ -107,6 +130,59 @@ TopoDS_Shape make_compound(std::initializer_list<TopoDS_Shape> solids) {
   builder.MakeCompound(compound);
   for (const TopoDS_Shape& s : solids) builder.Add(compound, s);
   return compound;
+}
+
+TopoDS_Shape make_tube(double r, double t, double h) {
+  const TopoDS_Shape outer = BRepPrimAPI_MakeCylinder(r, h).Shape();
+  // The bore overhangs both ends so the cut leaves no face of zero thickness.
+  const gp_Ax2 axis(gp_Pnt(0, 0, -h), gp::DZ());
+  return BRepAlgoAPI_Cut(outer, BRepPrimAPI_MakeCylinder(axis, r - t, 3 * h).Shape()).Shape();
+}
+
+TopoDS_Shape make_holed_plate(int n, double s, double h, double r) {
+  // One boolean with every hole as a tool: n² successive cuts would each
+  // rebuild an ever larger shape.
+  TopTools_ListOfShape plate, holes;
+  plate.Append(BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), s, s, h).Shape());
+  const double pitch = s / n;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const gp_Ax2 axis(gp_Pnt((i + 0.5) * pitch, (j + 0.5) * pitch, -h), gp::DZ());
+      holes.Append(BRepPrimAPI_MakeCylinder(axis, r, 3 * h).Shape());
+    }
+  BRepAlgoAPI_Cut cut;
+  cut.SetArguments(plate);
+  cut.SetTools(holes);
+  cut.SetRunParallel(false);
+  cut.Build();
+  if (!cut.IsDone()) throw GeometryError("builtin:holes: the boolean cut failed");
+  return cut.Shape();
+}
+
+TopoDS_Shape make_sunk_cylinder(double r, double d) {
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 2, 1, 1).Shape();
+  const gp_Ax2 axis(gp_Pnt(0.5, 0.5, 1 + r - d), gp::DX());
+  return BRepAlgoAPI_Fuse(box, BRepPrimAPI_MakeCylinder(axis, r, 1).Shape()).Shape();
+}
+
+TopoDS_Shape make_small_features(double s, double e) {
+  const TopoDS_Shape cube = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), s, s, s).Shape();
+  // The top edge along x at y = 0: the only edge with both ends at y = 0, z = s.
+  BRepFilletAPI_MakeChamfer chamfer(cube);
+  TopTools_IndexedMapOfShape edges;
+  TopExp::MapShapes(cube, TopAbs_EDGE, edges);
+  for (int i = 1; i <= edges.Extent(); ++i) {
+    const TopoDS_Edge& edge = TopoDS::Edge(edges(i));
+    const gp_Pnt a = BRep_Tool::Pnt(TopExp::FirstVertex(edge));
+    const gp_Pnt b = BRep_Tool::Pnt(TopExp::LastVertex(edge));
+    if (a.Y() == 0 && b.Y() == 0 && a.Z() == s && b.Z() == s) chamfer.Add(e, edge);
+  }
+  TopoDS_Shape shape = chamfer.Shape();
+  // The cutters overhang the cube so that no face of theirs is coplanar with one of its.
+  const TopoDS_Shape step = BRepPrimAPI_MakeBox(gp_Pnt(-e, 2 * s / 3, s - e), s + 2 * e, s / 3 + e, 2 * e).Shape();
+  shape = BRepAlgoAPI_Cut(shape, step).Shape();
+  const TopoDS_Shape notch = BRepPrimAPI_MakeBox(gp_Pnt(s - e, -e, -e), 2 * e, 2 * e, 2 * e).Shape();
+  return BRepAlgoAPI_Cut(shape, notch).Shape();
 }
 
 TopoDS_Shape make_part(double s) {
@@ -157,11 +233,12 @@ ReadShape make_builtin(const std::string& spec) {
   const Builtin* b = nullptr;
   for (const Builtin& candidate : builtins())
     if (candidate.name == name) b = &candidate;
-  if (!b)
-    throw InputError(spec, -1, -1,
-                     fmt::format("unknown built-in model '{}' (box, sphere, cylinder, torus, "
-                                 "cone, part, blocks, inclusion)",
-                                 name));
+  if (!b) {
+    std::string names;
+    for (const Builtin& candidate : builtins())
+      names += fmt::format("{}{}", names.empty() ? "" : ", ", candidate.name);
+    throw InputError(spec, -1, -1, fmt::format("unknown built-in model '{}' ({})", name, names));
+  }
   const Params p = parse_params(spec, *b, list);
   const auto positive = [&](const char* key) {
     require(p.at(key) > 0, spec, fmt::format("{} must be > 0", key));
@@ -193,12 +270,46 @@ ReadShape make_builtin(const std::string& spec) {
       const double h = side / 2;
       out.shape = make_compound({BRepPrimAPI_MakeBox(gp_Pnt(-h, -h, -h), side, side, side).Shape(),
                                  BRepPrimAPI_MakeSphere(r).Shape()});
+    } else if (name == "thinwall") {
+      const double r = positive("r"), t = positive("t");
+      require(t < r, spec, "the wall thickness t must be < r");
+      out.shape = make_tube(r, t, positive("h"));
+    } else if (name == "holes") {
+      const double n = p.at("n"), s = positive("s"), r = positive("r");
+      require(n >= 1 && n <= 100 && n == std::floor(n), spec, "n must be an integer in [1, 100]");
+      require(2 * r < s / n, spec, "the holes (2r) must fit in their cells (s/n)");
+      out.shape = make_holed_plate(static_cast<int>(n), s, positive("h"), r);
+    } else if (name == "tangent") {
+      const double r = positive("r"), d = positive("d");
+      require(r < 0.5, spec, "r must be < 0.5 (the cylinder fits on the top face)");
+      require(d < r, spec, "d must be < r");
+      out.shape = make_sunk_cylinder(r, d);
+    } else if (name == "smalledges") {
+      const double s = positive("s"), e = positive("e");
+      require(e < s / 10, spec, "e must be < s/10");
+      // Closer to OCC's confusion tolerance (1e-7) the features are within
+      // the model's own tolerance and planar faces stop being exact.
+      require(e >= 1e-6, spec, "e must be >= 1e-6 (ten times the modelling tolerance)");
+      out.shape = make_small_features(s, e);
     } else {
       out.shape = make_part(positive("scale"));
     }
   } catch (const Standard_Failure& e) {
     throw GeometryError(fmt::format("{}: construction failed: {}", spec, e.GetMessageString()));
   }
+  // Parameters at the edge of what a boolean can resolve may give a shape
+  // load_model would then heal and renumber, or leave the operands apart (a
+  // cylinder sunk 1e-7 stays a second solid touching the box): refuse them
+  // here rather than mesh something else than the description says.
+  if (!BRepCheck_Analyzer(out.shape).IsValid())
+    throw GeometryError(fmt::format("{}: the parameters give an invalid solid", spec));
+  const int expected_solids = name == "blocks" || name == "inclusion" ? 2 : 1;
+  int solids = 0;
+  for (TopExp_Explorer ex(out.shape, TopAbs_SOLID); ex.More(); ex.Next()) ++solids;
+  if (solids != expected_solids)
+    throw GeometryError(fmt::format("{}: the construction gives {} solids instead of {} (a feature "
+                                    "too small for the boolean operation to resolve)",
+                                    spec, solids, expected_solids));
   return out;
 }
 
