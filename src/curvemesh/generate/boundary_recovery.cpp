@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <fmt/format.h>
 
@@ -225,6 +226,7 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   std::vector<std::pair<VertId, VertId>> to_split;
   std::vector<TetId> ball;
   std::vector<std::uint64_t> all_edges;
+  std::unordered_set<std::uint64_t> flip_made;
   std::vector<Triple> all_faces;
   int last_face = 0;
   auto split_and_insert = [&](VertId a, VertId b) {
@@ -369,10 +371,15 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     // Surface flips first: a flipped edge needs no Steiner point. Vertices
     // of flipped triangles are checked again next round (no tet changed, so
     // the rebuild hook did not mark them).
-    std::size_t flipped = 0;
+    // Only edges missing from the tetrahedralization are flipped (the split
+    // of a missing triangle's longest edge stays a split), and never an edge
+    // a flip made: flips then only ever add Delaunay edges to the surface
+    // and cannot undo each other, so they end.
+    const auto first_missing = to_split.front();
+    std::size_t flipped = 0, index = 0;
     std::erase_if(to_split, [&](const std::pair<VertId, VertId>& e) {
       const auto [a, b] = e;
-      if (!surf.exists(a, b)) return false;
+      if (index++ >= missing_edges || !surf.exists(a, b) || flip_made.count(edge_key(a, b))) return false;
       const auto it = surf.edges().find(edge_key(a, b));
       std::array<VertId, 4> quad{a, b, kNone, kNone};
       if (it != surf.edges().end() && it->second.size() == 2)
@@ -380,15 +387,15 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
           for (VertId v : m.tris[it->second[k]].verts)
             if (v != a && v != b) quad[2 + k] = v;
       if (!surf.flip_to_mesh(a, b, ball)) return false;
+      flip_made.insert(edge_key(quad[2], quad[3]));
       if (dirty.size() < m.coords.size()) dirty.resize(m.coords.size(), 0);
       for (VertId v : quad) dirty[v] = 1;
       ++flipped;
       return true;
     });
     st.surface_flips += flipped;
-    if (to_split.empty()) continue;
     if (st.rounds >= o.max_rounds || st.steiner_on_edges + st.steiner_on_faces > max_steiner) {
-      const auto [a, b] = to_split.front();
+      const auto [a, b] = first_missing;
       const Vec3 x = m.coords[a], y = m.coords[b];
       throw GeometryError(fmt::format("face {}: boundary recovery did not converge ({} rounds, {} Steiner points, "
                                       "{} edges and {} triangles still missing; one is the edge ({:.6g} {:.6g} "
@@ -396,6 +403,7 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
                                       last_face, st.rounds, st.steiner_on_edges + st.steiner_on_faces, missing_edges,
                                       missing_tris, x.x(), x.y(), x.z(), y.x(), y.y(), y.z(), (x - y).norm()));
     }
+    if (to_split.empty()) continue;  // only flips this round
     std::sort(to_split.begin(), to_split.end());
     for (const auto& [a, b] : to_split) {
       if (!surf.exists(a, b)) continue;  // already split this round

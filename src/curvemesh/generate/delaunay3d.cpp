@@ -131,6 +131,38 @@ bool Delaunay3d::protect(const std::array<VertId, 3>& face) {
   return true;
 }
 
+std::size_t Delaunay3d::protect_all(std::span<const mesh::ClassifiedTri> faces) {
+  auto& m = editor_.mesh();
+  auto sorted = [](std::array<VertId, 3> k) {
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  std::vector<std::array<VertId, 3>> keys;
+  keys.reserve(faces.size());
+  for (const auto& f : faces) keys.push_back(sorted(f.verts));
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<char> found(keys.size(), 0);
+  for (TetId t = 0; t < m.tet2verts.size(); ++t) {
+    if (editor_.is_dead(t)) continue;
+    const auto& tv = m.tet2verts[t];
+    for (int f = 0; f < 4; ++f) {
+      const auto& fv = mesh::kFaceVerts[f];
+      const auto key = sorted({tv[fv[0]], tv[fv[1]], tv[fv[2]]});
+      const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+      if (it == keys.end() || *it != key) continue;
+      const Index packed = mesh::pack_face(t, f);
+      if (!editor_.face_marked(packed)) {
+        // mark_face marks both sides: count the face once.
+        ++protected_count_;
+        editor_.mark_face(packed);
+      }
+      found[static_cast<std::size_t>(it - keys.begin())] = 1;
+    }
+  }
+  return static_cast<std::size_t>(std::count(found.begin(), found.end(), 0));
+}
+
 bool Delaunay3d::is_protected(const std::array<VertId, 3>& face) const {
   const Index f = find_face(face);
   return f != kNone && editor_.face_marked(f);

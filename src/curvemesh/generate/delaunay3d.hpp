@@ -63,6 +63,10 @@ class Delaunay3d {
   /// not cross; the mark follows the face through later insertions. Returns
   /// false if the triple is not a face of the mesh.
   bool protect(const std::array<VertId, 3>& face);
+  /// Protects many faces in one pass over the tets (no ball walks, so also
+  /// faces at a vertex whose tets are not connected through faces, as at a
+  /// pinched point of a domain). Returns how many of them are no face.
+  std::size_t protect_all(std::span<const mesh::ClassifiedTri> faces);
   bool is_protected(const std::array<VertId, 3>& face) const;
   std::size_t protected_faces() const { return protected_count_; }
 

@@ -154,8 +154,8 @@ Vec3 circumcentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMeshOptions& o, VolumeMeshStats& st) {
   auto& m = dt.mesh();
   auto& ed = dt.editor();
-  for (const auto& t : m.tris)
-    if (!dt.protect(t.verts)) throw InternalError("interior refinement: a recovered boundary triangle is no face");
+  if (const std::size_t lost = dt.protect_all(m.tris); lost != 0)
+    throw InternalError(fmt::format("interior refinement: {} recovered boundary triangles are no face", lost));
   std::vector<double> vh(m.coords.size(), INFINITY);
   tbb::parallel_for(VertId{0}, static_cast<VertId>(m.coords.size()), [&](VertId v) {
     if (!dt.is_far(v)) vh[v] = size.size(m.coords[v]);
