@@ -282,3 +282,18 @@ TEST(SizeOctree, FirstInsertedRequestNamesTheSourceOnATie) {
     EXPECT_GT(named, 0);
   }
 }
+
+// size(x) starts from a grid of octants, not the root: at every leaf's
+// centre it must read that leaf, whose trilinear value there is the mean of
+// its corners (Leaf::size). A wrong octant from the grid reads a neighbour's
+// corners, clamped to its box.
+TEST(SizeOctree, PointQueriesReadTheLeafHoldingThePoint) {
+  const auto ball = std::make_shared<BallField>(Vec3(0.4, 0.6, 0.6), 0.25, 0.04, 1e-3);
+  const auto tree = make_mixed_tree(ball);
+  const auto leaves = tree->leaves();
+  ASSERT_GT(leaves.size(), 5000u);
+  std::size_t wrong = 0;
+  for (const auto& l : leaves)
+    if (std::abs(tree->size(centre(l)) - l.size) > 1e-12 * l.size) ++wrong;
+  EXPECT_EQ(wrong, 0u);
+}

@@ -410,3 +410,28 @@ TEST(SizeBuild, RegionSizeOnAMissingRegionNamesIt) {
   four.entity_sizes = {{{4, 1}, 0.1}};
   EXPECT_THROW(build_size_field(*blocks, four), std::invalid_argument);
 }
+
+// Samplers take point, derivatives and curvatures from one face_geometry
+// call; on CAD faces it must give what the separate queries give.
+TEST(SizeBuild, FaceGeometryMatchesTheSeparateQueries) {
+  const auto part = geom_occ::load_model("builtin:part");
+  int compared = 0;
+  for (int f = 1; f <= part->count(2); ++f) {
+    const geom::ParamRange pr = part->param_range({2, f});
+    for (int i = 1; i < 8; ++i)
+      for (int j = 1; j < 8; ++j) {
+        const Vec2 uv(pr.u0 + (pr.u1 - pr.u0) * i / 8.0, pr.v0 + (pr.v1 - pr.v0) * j / 8.0);
+        const geom::SurfaceGeometry g = part->face_geometry(f, uv);
+        const geom::SurfaceDerivatives d = part->face_derivatives(f, uv);
+        ASSERT_EQ(g.derivatives.point, d.point);
+        ASSERT_EQ(g.derivatives.duv, d.duv);
+        if (!g.regular) continue;
+        const geom::Curvatures c = part->face_curvatures(f, uv);
+        ASSERT_EQ(g.curvatures.k1, c.k1) << f;
+        ASSERT_EQ(g.curvatures.k2, c.k2) << f;
+        ASSERT_EQ(g.curvatures.dir1, c.dir1) << f;
+        ++compared;
+      }
+  }
+  EXPECT_GT(compared, 100);
+}

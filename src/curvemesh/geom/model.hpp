@@ -94,6 +94,15 @@ struct Curvatures {
   Vec3 dir1 = Vec3::UnitX(), dir2 = Vec3::UnitY();
 };
 
+/// Everything a face evaluation gives at one (u, v): see Model::face_geometry.
+struct SurfaceGeometry {
+  SurfaceDerivatives derivatives;
+  /// Set only where `regular`; see Curvatures for signs and directions.
+  Curvatures curvatures;
+  /// du × dv does not vanish: |du × dv| > 1e-12 |du| |dv|.
+  bool regular = false;
+};
+
 /// Where a point lies with respect to a region (classify_point).
 enum class Containment {
   kOutside,
@@ -145,6 +154,20 @@ class Model {
   /// region(s) the face bounds as oriented in its first region's shell.
   virtual Vec3 face_normal(int face, const Vec2& uv) const = 0;
   virtual Curvatures face_curvatures(int face, const Vec2& uv) const = 0;
+  /// Point, derivatives and (where regular) principal curvatures at (u, v),
+  /// the curvatures equal to face_curvatures(face, uv) there. Samplers that
+  /// need all three call this once: the default asks face_derivatives and
+  /// face_curvatures, and a backend whose evaluation is expensive overrides
+  /// it to evaluate the surface once.
+  virtual SurfaceGeometry face_geometry(int face, const Vec2& uv) const {
+    SurfaceGeometry g;
+    g.derivatives = face_derivatives(face, uv);
+    const SurfaceDerivatives& d = g.derivatives;
+    const double scale = d.du.norm() * d.dv.norm();
+    g.regular = scale > 0 && d.du.cross(d.dv).norm() > 1e-12 * scale;
+    if (g.regular) g.curvatures = face_curvatures(face, uv);
+    return g;
+  }
   /// Curvature (1 / radius) of an edge at u; 0 for a line.
   virtual double edge_curvature(int edge, double u) const = 0;
   /// Closest point on an edge or face; `hint` (parameters near the answer)

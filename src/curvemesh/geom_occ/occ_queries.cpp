@@ -85,13 +85,10 @@ Vec3 OccModel::face_normal(int face, const Vec2& uv) const {
   return n;
 }
 
-geom::Curvatures OccModel::face_curvatures(int face, const Vec2& uv) const {
-  const FaceData& f = face_at(face);
-  geom::SurfaceDerivatives d;
-  Vec3 n;
-  if (!regular_derivatives(f, face, uv, d, n))
-    throw GeometryError(fmt::format("face {}: no curvature at ({}, {}): singular parametrization",
-                                    face, uv.x(), uv.y()));
+namespace {
+
+// n: the unit normal of d, out of the material.
+geom::Curvatures curvatures_of(const geom::SurfaceDerivatives& d, const Vec3& n) {
   // Second fundamental form in an orthonormal tangent frame (e1, e2), where
   // it is a symmetric 2x2 matrix whose eigenpairs are the principal
   // curvatures and directions. A tangent t = a du + b dv has (a, b) = I^-1
@@ -124,6 +121,33 @@ geom::Curvatures OccModel::face_curvatures(int face, const Vec2& uv) const {
   k.dir1 = (w.x() * e1 + w.y() * e2).normalized();
   k.dir2 = n.cross(k.dir1);
   return k;
+}
+
+}  // namespace
+
+geom::Curvatures OccModel::face_curvatures(int face, const Vec2& uv) const {
+  const FaceData& f = face_at(face);
+  geom::SurfaceDerivatives d;
+  Vec3 n;
+  if (!regular_derivatives(f, face, uv, d, n))
+    throw GeometryError(fmt::format("face {}: no curvature at ({}, {}): singular parametrization",
+                                    face, uv.x(), uv.y()));
+  return curvatures_of(d, n);
+}
+
+// One D2 evaluation where face_point, face_derivatives and face_curvatures
+// would make three; at a regular point regular_derivatives takes exactly
+// this evaluation, so the curvatures are face_curvatures' own.
+geom::SurfaceGeometry OccModel::face_geometry(int face, const Vec2& uv) const {
+  const FaceData& f = face_at(face);
+  geom::SurfaceGeometry g;
+  g.derivatives = eval_surface(f, face, uv);
+  const geom::SurfaceDerivatives& d = g.derivatives;
+  const Vec3 cross = d.du.cross(d.dv);
+  const double scale = d.du.norm() * d.dv.norm();
+  g.regular = scale > 0 && cross.norm() > 1e-12 * scale;
+  if (g.regular) g.curvatures = curvatures_of(d, (f.flip_normal ? -cross : cross).normalized());
+  return g;
 }
 
 double OccModel::edge_curvature(int edge, double u) const {

@@ -46,14 +46,19 @@ double surface_curvature_length(const geom::Curvatures& c, const CurvatureRule& 
 }
 
 bool usable_curvatures(const geom::Model& model, int face, const Vec2& uv, geom::Curvatures* out) {
+  return usable_curvatures(model.face_geometry(face, uv), model.tolerance({2, face}), out);
+}
+
+bool usable_curvatures(const geom::SurfaceGeometry& g, double tolerance, geom::Curvatures* out) {
   // A singular point of the parametrization: du × dv (nearly) vanishes, e.g.
-  // every point of a sphere's pole row of (u, v).
-  const geom::SurfaceDerivatives d = model.face_derivatives(face, uv);
+  // every point of a sphere's pole row of (u, v). This bound is stricter
+  // than SurfaceGeometry::regular, so the curvatures are set past it.
+  const geom::SurfaceDerivatives& d = g.derivatives;
   const double area = d.du.cross(d.dv).norm(), scale = d.du.squaredNorm() + d.dv.squaredNorm();
-  if (!(area > 1e-8 * scale)) return false;
-  const geom::Curvatures c = model.face_curvatures(face, uv);
+  if (!(area > 1e-8 * scale) || !g.regular) return false;
+  const geom::Curvatures& c = g.curvatures;
   const double k = std::max(std::abs(c.k1), std::abs(c.k2));
-  if (!std::isfinite(k) || k * model.tolerance({2, face}) >= 1) return false;
+  if (!std::isfinite(k) || k * tolerance >= 1) return false;
   *out = c;
   return true;
 }

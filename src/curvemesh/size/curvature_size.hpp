@@ -50,6 +50,9 @@ double surface_curvature_length(const geom::Curvatures& c, const CurvatureRule& 
 /// are artefacts of du × dv vanishing; a radius below the model tolerance
 /// cannot be meshed anyway. Returns false for those.
 bool usable_curvatures(const geom::Model& model, int face, const Vec2& uv, geom::Curvatures* out);
+/// The same test on an evaluation already made (Model::face_geometry), with
+/// the face's tolerance.
+bool usable_curvatures(const geom::SurfaceGeometry& g, double tolerance, geom::Curvatures* out);
 
 /// Octree level of eq. 4.6 for a length ℓ in a root cube of side L:
 /// N = log₂(L/ℓ), rounded up so the octant side L/2ᴺ is <= ℓ; >= 0.

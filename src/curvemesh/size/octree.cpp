@@ -298,7 +298,15 @@ void SizeOctree::balance(std::vector<std::uint32_t> work) {
   }
 }
 
-void SizeOctree::assign_corners() {
+// Returns the corners grading and conformity must start from: every corner
+// of a leaf made since the last call, and every corner a source lowered
+// below what it carried over.
+std::vector<std::uint32_t> SizeOctree::assign_corners() {
+  // A corner of a leaf stays a corner of one of its descendants, so every
+  // old corner has a new id, and its graded and conformed size still holds.
+  const std::vector<std::array<std::uint32_t, 3>> old_units = std::move(node_units_);
+  const std::vector<double> old_value = std::move(node_value_);
+  const std::vector<SizeSource> old_source = std::move(node_source_);
   leaves_ = leaf_octants();
   by_octant_.resize(leaves_.size());
   std::iota(by_octant_.begin(), by_octant_.end(), 0u);
@@ -323,10 +331,22 @@ void SizeOctree::assign_corners() {
   const std::size_t n = node_units_.size();
   node_value_.assign(n, opt_.hmax);
   node_source_.assign(n, SizeSource::kHmax);
+  for (std::size_t i = 0; i < old_units.size(); ++i) {
+    const auto& u = old_units[i];
+    const std::int64_t id = node_of_.find(key(u[0], u[1], u[2]));
+    CM_ASSERT(id >= 0);
+    node_value_[static_cast<std::size_t>(id)] = old_value[i];
+    node_source_[static_cast<std::size_t>(id)] = old_source[i];
+  }
+  const std::vector<double> carried = node_value_;
   // Leaves and requests are both in Morton order: one merge finds every
   // request's leaf. Per corner the smallest size wins, and among equal
   // sizes the request inserted first.
   std::vector<std::uint32_t> winner(n, kNone32);
+  // A carried size keeps its source on a tie: the request that named it
+  // may lie in a neighbouring leaf by now.
+  for (std::size_t i = 0; i < n; ++i)
+    if (carried[i] < opt_.hmax) winner[i] = 0;
   std::size_t k = 0;
   for (std::size_t l = 0; l < leaves_.size() && k < request_order_.size(); ++l) {
     const Octant& o = octants_[leaves_[l]];
@@ -349,6 +369,20 @@ void SizeOctree::assign_corners() {
       }
   }
   for (FieldState& field : fields_) evaluate_field(field);
+
+  std::vector<char> listed(n, 0);
+  std::vector<std::uint32_t> seeds;
+  for (std::size_t l = 0; l < leaves_.size(); ++l)
+    if (leaves_[l] >= cornered_octants_)
+      for (const std::uint32_t node : leaf_nodes_[l])
+        if (!listed[node]) {
+          listed[node] = 1;
+          seeds.push_back(node);
+        }
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (!listed[i] && node_value_[i] < carried[i]) seeds.push_back(i);
+  cornered_octants_ = static_cast<std::uint32_t>(octants_.size());
+  return seeds;
 }
 
 // A field's value at every corner and at every leaf's centre (at the finest
@@ -473,11 +507,25 @@ void SizeOctree::build_incidence() {
     if (octants_[oa].level != octants_[ob].level) return octants_[oa].level > octants_[ob].level;
     return oa != ob ? oa < ob : a.midpoint < b.midpoint;
   });
+  hanging_start_.assign(n + 1, 0);
+  const auto each_node = [&](const Hanging& hg, auto&& visit) {
+    visit(hg.node);
+    for (const int c : mids[hg.midpoint].corners)
+      if (c >= 0) visit(leaf_nodes_[hg.leaf][c]);
+  };
+  for (const Hanging& hg : hanging_) each_node(hg, [&](std::uint32_t v) { ++hanging_start_[v + 1]; });
+  for (std::size_t i = 0; i < n; ++i) hanging_start_[i + 1] += hanging_start_[i];
+  hanging_of_.resize(hanging_start_[n]);
+  fill.assign(hanging_start_.begin(), hanging_start_.end() - 1);
+  for (std::uint32_t e = 0; e < hanging_.size(); ++e)
+    each_node(hanging_[e], [&](std::uint32_t v) { hanging_of_[fill[v]++] = e; });
+  hanging_queued_.assign(hanging_.size(), 0);
 }
 
 // Shortest paths from the seeds with their sizes as start distances:
 // h(b) = min over a of h(a) + (hgrad−1)|ab|, over corners of a common leaf.
-void SizeOctree::grade(std::span<const std::uint32_t> seeds) {
+// Appends every corner it lowers to `changed`.
+void SizeOctree::grade(std::span<const std::uint32_t> seeds, std::vector<std::uint32_t>& changed) {
   const double rate = kGradeSafety * (opt_.hgrad - 1);
   using Item = std::pair<double, std::uint32_t>;
   std::vector<Item> heap;
@@ -501,6 +549,7 @@ void SizeOctree::grade(std::span<const std::uint32_t> seeds) {
           node_value_[b] = cand;
           node_source_[b] = SizeSource::kGradation;
           queue.emplace(cand, b);
+          changed.push_back(b);
         }
       }
     }
@@ -508,7 +557,13 @@ void SizeOctree::grade(std::span<const std::uint32_t> seeds) {
 }
 
 // Continuity at hanging corners; returns the corners whose size moved.
-std::vector<std::uint32_t> SizeOctree::conform() {
+// Only the entries of hanging_ that a corner in `dirty` takes part in can
+// be out of balance (the others were settled in an earlier pass or round
+// and none of their corners changed since), so each sweep is a work list
+// over those, visited in hanging_'s order, that grows as a sweep moves
+// corners the entries still ahead of it read. A corner moved that an entry
+// already behind it reads goes to the next pass, as a full sweep would do.
+std::vector<std::uint32_t> SizeOctree::conform(std::span<const std::uint32_t> dirty) {
   std::vector<std::uint32_t> moved;
   const auto& mids = midpoints();
   const auto interpolate = [&](const Hanging& hg) {
@@ -521,11 +576,29 @@ std::vector<std::uint32_t> SizeOctree::conform() {
       }
     return sum / count;
   };
+  std::vector<std::uint32_t> start;
+  const auto enlist_all = [&](std::uint32_t node) {
+    for (std::uint32_t k = hanging_start_[node]; k < hanging_start_[node + 1]; ++k) {
+      const std::uint32_t e = hanging_of_[k];
+      if (!hanging_queued_[e]) {
+        hanging_queued_[e] = 1;
+        start.push_back(e);
+      }
+    }
+  };
+  for (const std::uint32_t node : dirty) enlist_all(node);
+
   // Finest first: where a hanging corner asks for less than a larger
   // octant interpolates there, lower that octant's corners on the face (or
   // edge) to a common cap t, the least change that makes the interpolation
   // equal to what the corner asks; corners already below t keep their size.
-  for (const Hanging& hg : hanging_) {
+  std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, std::greater<>> ahead(std::greater<>{}, start);
+  std::vector<std::uint32_t> lowered;
+  while (!ahead.empty()) {
+    const std::uint32_t e = ahead.top();
+    ahead.pop();
+    hanging_queued_[e] = 0;
+    const Hanging& hg = hanging_[e];
     const double want = node_value_[hg.node];
     if (!(interpolate(hg) - want > kConformTolerance * want)) continue;
     std::array<double, 4> c;
@@ -552,14 +625,39 @@ std::vector<std::uint32_t> SizeOctree::conform() {
         node_value_[node] = cap;
         node_source_[node] = node_source_[hg.node];
         moved.push_back(node);
+        lowered.push_back(node);
+        for (std::uint32_t q = hanging_start_[node]; q < hanging_start_[node + 1]; ++q) {
+          const std::uint32_t later = hanging_of_[q];
+          if (later > e && !hanging_queued_[later]) {
+            hanging_queued_[later] = 1;
+            ahead.push(later);
+          }
+        }
       }
     }
   }
-  // Coarsest first: a hanging corner takes the larger octant's value.
-  for (auto it = hanging_.rbegin(); it != hanging_.rend(); ++it) {
-    const double v = interpolate(*it);
-    if (std::abs(v - node_value_[it->node]) > kConformTolerance * node_value_[it->node]) moved.push_back(it->node);
-    node_value_[it->node] = v;
+
+  // Coarsest first: a hanging corner takes the larger octant's value. The
+  // entries to redo are the first sweep's and those of the corners it lowered.
+  for (const std::uint32_t e : start) hanging_queued_[e] = 1;
+  for (const std::uint32_t node : lowered) enlist_all(node);
+  std::priority_queue<std::uint32_t> behind(std::less<std::uint32_t>{}, std::move(start));
+  while (!behind.empty()) {
+    const std::uint32_t e = behind.top();
+    behind.pop();
+    hanging_queued_[e] = 0;
+    const Hanging& hg = hanging_[e];
+    const double v = interpolate(hg), old = node_value_[hg.node];
+    if (v == old) continue;
+    if (std::abs(v - old) > kConformTolerance * old) moved.push_back(hg.node);
+    node_value_[hg.node] = v;
+    for (std::uint32_t q = hanging_start_[hg.node]; q < hanging_start_[hg.node + 1]; ++q) {
+      const std::uint32_t earlier = hanging_of_[q];
+      if (earlier < e && !hanging_queued_[earlier]) {
+        hanging_queued_[earlier] = 1;
+        behind.push(earlier);
+      }
+    }
   }
   std::sort(moved.begin(), moved.end());
   moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
@@ -607,28 +705,68 @@ void SizeOctree::build() {
   std::sort(fresh.begin(), fresh.end());
   for (rounds_ = 1;; ++rounds_) {
     balance(std::move(fresh));
-    assign_corners();
+    std::vector<std::uint32_t> seeds = assign_corners();
     build_incidence();
-    std::vector<std::uint32_t> seeds(node_value_.size());
-    for (std::uint32_t i = 0; i < seeds.size(); ++i) seeds[i] = i;
+    std::vector<std::uint32_t> dirty = seeds;
     for (int k = 0; k < kMaxConformPasses && !seeds.empty(); ++k) {
-      grade(seeds);
-      seeds = conform();
+      grade(seeds, dirty);
+      seeds = conform(dirty);
+      dirty = seeds;
     }
     if (rounds_ >= 4 * opt_.max_depth) break;
     fresh = refine_to_sizes();
     if (fresh.empty()) break;
   }
+  build_query_grid();
   built_ = true;
+}
+
+void SizeOctree::build_query_grid() {
+  // As fine as the tree goes, but with no more cells than about twice the
+  // octants, so the grid costs less memory than the tree it indexes.
+  grid_level_ = 0;
+  const int deepest = depth();
+  while (grid_level_ < std::min(deepest, 10) && (std::size_t{8} << (3 * grid_level_)) <= 2 * octants_.size())
+    ++grid_level_;
+  const std::uint32_t n = std::uint32_t{1} << grid_level_;
+  grid_.assign(std::size_t{n} * n * n, 0);
+  const int shift = opt_.max_depth - grid_level_;
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t o = stack.back();
+    stack.pop_back();
+    const Octant& q = octants_[o];
+    if (q.first_child >= 0 && q.level < grid_level_) {
+      for (std::uint32_t c = 0; c < 8; ++c) stack.push_back(static_cast<std::uint32_t>(q.first_child) + c);
+      continue;
+    }
+    const std::uint32_t span = std::uint32_t{1} << (grid_level_ - q.level);
+    const std::uint32_t x0 = q.ix >> shift, y0 = q.iy >> shift, z0 = q.iz >> shift;
+    for (std::uint32_t z = z0; z < z0 + span; ++z)
+      for (std::uint32_t y = y0; y < y0 + span; ++y)
+        std::fill_n(grid_.begin() + ((std::size_t{z} * n + y) * n + x0), span, o);
+  }
+}
+
+std::uint32_t SizeOctree::find_leaf_fast(const std::array<std::uint32_t, 3>& u) const {
+  const int shift = opt_.max_depth - grid_level_;
+  const std::size_t n = std::size_t{1} << grid_level_;
+  std::uint32_t o = grid_[((u[2] >> shift) * n + (u[1] >> shift)) * n + (u[0] >> shift)];
+  while (octants_[o].first_child >= 0) {
+    const int bit = opt_.max_depth - octants_[o].level - 1;
+    const std::uint32_t child = ((u[0] >> bit) & 1u) | (((u[1] >> bit) & 1u) << 1) | (((u[2] >> bit) & 1u) << 2);
+    o = static_cast<std::uint32_t>(octants_[o].first_child) + child;
+  }
+  return o;
 }
 
 double SizeOctree::size(const Vec3& x, const SizeHint&) const {
   if (!built_) throw std::logic_error("size octree: query before build()");
-  const auto u = to_units(x);
-  const std::uint32_t o = find(u[0], u[1], u[2]);
+  const std::uint32_t o = find_leaf_fast(to_units(x));
   const Octant& oct = octants_[o];
-  const auto& c = leaf_nodes_[static_cast<std::size_t>(octant_leaf_[o])];
-  const double s = std::ldexp(side_, -oct.level);
+  const auto leaf = static_cast<std::size_t>(octant_leaf_[o]);
+  const auto& c = leaf_nodes_[leaf];
+  const double s = leaf_side_[leaf];
   const Vec3 t = ((x - to_point(oct.ix, oct.iy, oct.iz)) / s).cwiseMax(0.0).cwiseMin(1.0);
   const auto v = [&](int k) { return node_value_[c[k]]; };
   const double x00 = v(0) + t.x() * (v(1) - v(0)), x10 = v(2) + t.x() * (v(3) - v(2));

@@ -5,8 +5,9 @@
 // side L/2ᴺ, and a requested length ℓ at a point refines the octant there to
 // level N = ⌈log₂(L/ℓ)⌉ (eq. 4.6; eqs. 4.7 and 4.8 are this N for the lengths
 // of eqs. 4.3 and 4.5). Sizes live at octant corners and are interpolated
-// trilinearly inside a leaf, so a query is a descent of the tree, O(depth),
-// and the field is continuous: a corner of a small octant lying on the face
+// trilinearly inside a leaf; a query reads a uniform grid of octants a few
+// levels above the finest leaves and descends the rest of the way, and the
+// field is continuous: a corner of a small octant lying on the face
 // or edge of a larger neighbour (a hanging corner) takes the value the larger
 // octant interpolates there.
 //
@@ -22,7 +23,9 @@
 //   octant where a hanging corner asks for less;
 // - refines every leaf whose side exceeds twice the smallest size at its
 //   corners (graded sizes vary slowly; requests themselves keep eq. 4.6's
-//   level) and repeats.
+//   level) and repeats. Sizes carry over from round to round: a round
+//   grades and conforms only from the corners of the leaves it made and the
+//   corners its sources lowered, so its cost follows what changed.
 // Every size only ever decreases from what a source asked, so the field is
 // never coarser than a source at the points the source was sampled.
 #include <array>
@@ -127,15 +130,17 @@ class SizeOctree final : public SizeField {
   Vec3 to_point(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) const;
   static Key key(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) { return ix | (iy << 21) | (iz << 42); }
   std::uint32_t find(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const;
+  std::uint32_t find_leaf_fast(const std::array<std::uint32_t, 3>& u) const;
   void split(std::uint32_t octant);
   std::vector<std::uint32_t> leaf_octants() const;
   void balance(std::vector<std::uint32_t> work);
-  void assign_corners();
+  std::vector<std::uint32_t> assign_corners();
   void evaluate_field(FieldState& state);
   void build_incidence();
-  void grade(std::span<const std::uint32_t> seeds);
-  std::vector<std::uint32_t> conform();
+  void grade(std::span<const std::uint32_t> seeds, std::vector<std::uint32_t>& changed);
+  std::vector<std::uint32_t> conform(std::span<const std::uint32_t> dirty);
   std::vector<std::uint32_t> refine_to_sizes();
+  void build_query_grid();
 
   OctreeOptions opt_;
   Vec3 origin_;
@@ -147,6 +152,9 @@ class SizeOctree final : public SizeField {
   std::vector<FieldState> fields_;
   bool built_ = false;
   int rounds_ = 0;
+  // Octants made before the last assign_corners(): any leaf numbered from
+  // here on is new since then.
+  std::uint32_t cornered_octants_ = 0;
 
   // Corner data, rebuilt by assign_corners().
   std::vector<std::uint32_t> leaves_;                        // octant ids of the leaves, in Morton order
@@ -183,6 +191,15 @@ class SizeOctree final : public SizeField {
     std::uint8_t midpoint;  // which edge midpoint or face centre
   };
   std::vector<Hanging> hanging_;  // larger octant's level descending
+  // Node -> the hanging_ entries it takes part in, as the hanging corner or
+  // as a corner of the larger octant (CSR): conformity revisits only those.
+  std::vector<std::uint32_t> hanging_start_, hanging_of_;
+  std::vector<char> hanging_queued_;
+  // Point queries: the octant covering each cell of a uniform grid at level
+  // grid_level_ (a leaf or an octant at that level), so that size(x) starts
+  // its descent a few levels above the leaf instead of at the root.
+  int grid_level_ = 0;
+  std::vector<std::uint32_t> grid_;
 };
 
 }  // namespace cm::size

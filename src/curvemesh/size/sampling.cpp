@@ -49,6 +49,12 @@ int cells_for(double extent, double spacing, int lo, int hi) {
 
 double clamp_size(double l, const SamplingOptions& o) { return std::max(l, o.hmin); }
 
+// Samples of one cell asking for lengths within this ratio agree (see
+// FaceSampler::visit_cell), and such a cell is subdivided only while wider
+// than kAgreeingCellRatio times that length.
+constexpr double kAgreeingSizeRatio = 1.25;
+constexpr double kAgreeingCellRatio = 2;
+
 // 3D extent of a face along u (or v): the longest of three iso-parametric
 // lines, each measured by a 16-segment polyline.
 double face_extent(const geom::Model& m, int face, const geom::ParamRange& pr, bool along_u) {
@@ -72,7 +78,13 @@ double face_extent(const geom::Model& m, int face, const geom::ParamRange& pr, b
 class FaceSampler {
  public:
   FaceSampler(const geom::Model& m, int face, const SamplingOptions& o, SamplingStats& st)
-      : m_(m), face_(face), o_(o), st_(st), pr_(m.param_range({2, face})), res_(lattice_resolution(o)) {}
+      : m_(m),
+        face_(face),
+        o_(o),
+        st_(st),
+        pr_(m.param_range({2, face})),
+        res_(lattice_resolution(o)),
+        tolerance_(m.tolerance({2, face})) {}
 
   std::vector<SizeSample> run() {
     if (!(pr_.u1 > pr_.u0) || !(pr_.v1 > pr_.v0)) return {};
@@ -88,6 +100,7 @@ class FaceSampler {
   struct Point {
     Vec3 x;
     double size;  // +inf where nothing is asked (outside the trim, flat)
+    bool inside;  // in the trimmed face
   };
 
   Vec2 param(std::int64_t i, std::int64_t j) const {
@@ -95,21 +108,28 @@ class FaceSampler {
             pr_.v0 + (pr_.v1 - pr_.v0) * double(j) / double(nv_ * res_)};
   }
 
-  const Point& eval(std::int64_t i, std::int64_t j) {
+  // `known_inside`: the caller vouches that (i, j) is in the trimmed face,
+  // which spares the trimming test, the costliest part of a CAD sample.
+  const Point& eval(std::int64_t i, std::int64_t j, bool known_inside = false) {
     const std::uint64_t key = (std::uint64_t(i) << 32) | std::uint64_t(j);
     if (const auto it = seen_.find(key); it != seen_.end()) {
       ++st_.revisited;
       return it->second;
     }
     const Vec2 uv = param(i, j);
-    Point p{m_.face_point(face_, uv), std::numeric_limits<double>::infinity()};
-    if (!m_.contains_param(face_, uv)) {
+    Point p{Vec3::Zero(), std::numeric_limits<double>::infinity(), false};
+    if (!known_inside && !m_.contains_param(face_, uv)) {
       ++st_.outside;
+      p.x = m_.face_point(face_, uv);
     } else {
       ++st_.evaluations;
+      p.inside = true;
+      // Point and curvatures from one evaluation of the surface.
+      const geom::SurfaceGeometry g = m_.face_geometry(face_, uv);
+      p.x = g.derivatives.point;
       // A pole or a singular point has no curvature to give.
       geom::Curvatures c;
-      if (usable_curvatures(m_, face_, uv, &c)) {
+      if (usable_curvatures(g, tolerance_, &c)) {
         p.size = clamp_size(surface_curvature_length(c, o_.rule), o_);
         if (p.size < o_.hmax)
           out_.push_back({p.x, p.size, SizeSource::kFaceCurvature, {2, face_}, uv, c.k1, c.k2, c.dir1});
@@ -122,10 +142,27 @@ class FaceSampler {
     // Copies: eval() may rehash the map.
     const Point c00 = eval(i0, j0), c10 = eval(i0 + s, j0), c01 = eval(i0, j0 + s), c11 = eval(i0 + s, j0 + s);
     double need = std::min({c00.size, c10.size, c01.size, c11.size});
-    if (o_.centroids) need = std::min(need, eval(i0 + s / 2, j0 + s / 2).size);
+    // A centroid between four corners in the face is taken as in it too: it
+    // is wrong only inside a hole smaller than the cell, where the sample
+    // then reads the curvature of the surface the hole was cut from, next
+    // to the face's own, which can only make the field finer there.
+    if (o_.centroids) {
+      const bool inside = c00.inside && c10.inside && c01.inside && c11.inside;
+      need = std::min(need, eval(i0 + s / 2, j0 + s / 2, inside).size);
+    }
     if (!o_.adaptive || depth >= o_.max_depth || s < 2 || !std::isfinite(need)) return;
     const double diameter = std::max((c11.x - c00.x).norm(), (c10.x - c01.x).norm());
     if (!(need < diameter) || diameter <= o_.hmin) return;
+    // Where the samples agree, the curvature is resolved: finer samples
+    // would repeat the same request, and a cell up to kAgreeingCellRatio
+    // times the length it asks for leaves the octree between them within a
+    // fraction of a gradation step of it (meshers take the exact size on the
+    // boundary from the hint anyway). Disagreeing samples still subdivide
+    // down to the length they ask for, which is what finds a narrow peak.
+    double widest = need;
+    for (const Point* p : {&c00, &c10, &c01, &c11})
+      if (std::isfinite(p->size)) widest = std::max(widest, p->size);
+    if (widest <= kAgreeingSizeRatio * need && diameter <= kAgreeingCellRatio * need) return;
     ++st_.subdivided;
     const std::int64_t h = s / 2;
     for (int a = 0; a < 2; ++a)
@@ -138,6 +175,7 @@ class FaceSampler {
   SamplingStats& st_;
   geom::ParamRange pr_;
   std::int64_t res_;
+  double tolerance_;
   int nu_ = 0, nv_ = 0;
   std::unordered_map<std::uint64_t, Point> seen_;
   std::vector<SizeSample> out_;

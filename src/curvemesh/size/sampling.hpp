@@ -9,7 +9,11 @@
 // The grid spacing comes from the face's extent in 3D and hmax; a cell whose
 // samples ask for a length smaller than the cell itself is subdivided (new
 // corners and centroids) so that a region of fast-varying curvature is
-// resolved where it is first seen. A curvature peak narrower than the grid
+// resolved where it is first seen; where the cell's samples agree, only
+// while the cell is more than twice the length they ask for. A centroid
+// between four corners inside the trimmed face is taken as inside without
+// asking the (costly) trimming test, and each sample is one face_geometry
+// evaluation. A curvature peak narrower than the grid
 // spacing that no sample touches stays unseen; the grid is what bounds it.
 #include <cstddef>
 #include <vector>

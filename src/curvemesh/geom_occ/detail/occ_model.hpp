@@ -197,6 +197,7 @@ class OccModel final : public geom::Model {
   geom::SurfaceDerivatives face_derivatives(int face, const Vec2& uv) const override;
   Vec3 face_normal(int face, const Vec2& uv) const override;
   geom::Curvatures face_curvatures(int face, const Vec2& uv) const override;
+  geom::SurfaceGeometry face_geometry(int face, const Vec2& uv) const override;
   double edge_curvature(int edge, double u) const override;
   geom::Projection closest_point(geom::EntityRef e, const Vec3& x,
                                  std::optional<Vec2> hint = {}) const override;
