@@ -104,7 +104,9 @@ int main(int argc, char** argv) {
             so.hmax = hmax_arg;
             const auto sf = cm::size::build_size_field(*model, so);
             auto m = cm::generate::mesh_volume(*model, *sf.field);
-            cm::optimize::improve_quality(m);  // as `curvemesh mesh` does
+            cm::optimize::ImproveOptions io;  // as `curvemesh mesh` does: boundary vertices move on the model
+            io.model = model.get();
+            cm::optimize::improve_quality(m, io);
             Row r;
             measure(m, r);
             r.valid = cm::mesh::validate(m, cm::mesh::Level::kFull).valid();
