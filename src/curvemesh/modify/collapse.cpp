@@ -242,11 +242,9 @@ CollapsePlan plan_collapse(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
       return plan;
     }
     if (model) {
-      std::optional<Vec2> hint;
-      for (VertId v : nv)
-        if (!hint) hint = param_on_face(m, model, v, tri.face_tag);
-      if (agrees_with_model(*model, tri.face_tag, x0, x1, x2, hint) &&
-          !agrees_with_model(*model, tri.face_tag, y0, y1, y2, hint)) {
+      // Judged as the boundary check will judge it, whatever the triangle
+      // did before.
+      if (!agrees_with_model(*model, tri.face_tag, y0, y1, y2, check_hint(m, nv, tri.face_tag))) {
         plan.refusal = Refusal::kFoldedSurface;
         return plan;
       }

@@ -147,8 +147,8 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
   for (TriBefore& x : tris) {
     const auto& tv = m.tris[x.tri].verts;
     x.normal = tri_normal(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]]);
-    x.agrees = agrees_with_model(*model, m.tris[x.tri].face_tag, m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]],
-                                 param_on_face(m, model, v, m.tris[x.tri].face_tag));
+    const int f = m.tris[x.tri].face_tag;
+    x.agrees = agrees_with_model(*model, f, m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], check_hint(m, tv, f));
   }
 
   candidates.clear();
@@ -176,8 +176,10 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
       const auto& tri = m.tris[x.tri];
       const Vec3 &a = m.coords[tri.verts[0]], &b = m.coords[tri.verts[1]], &d = m.coords[tri.verts[2]];
       if (!(tri_normal(a, b, d).dot(x.normal) > 0) ||
-          (x.agrees && !agrees_with_model(*model, tri.face_tag, a, b, d,
-                                          c.dim == 2 ? std::optional<Vec2>(cand.param) : std::nullopt))) {
+          (x.agrees &&
+           !agrees_with_model(*model, tri.face_tag, a, b, d,
+                              check_hint(m, tri.verts, tri.face_tag, v,
+                                         c.dim == 2 ? std::optional<Vec2>(cand.param) : std::nullopt)))) {
         ok = false;
         break;
       }

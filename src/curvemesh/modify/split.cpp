@@ -181,13 +181,19 @@ SplitPlan plan_split(MeshEditor& ed, Cavity& cav, const BoundaryIndex& surf, Ver
       return plan;
     }
     if (model) {
-      std::optional<Vec2> hint;
-      if (plan.classification.dim == 2) hint = Vec2(plan.param.u, plan.param.v);
-      for (VertId v : t)
-        if (!hint) hint = param_on_face(m, model, v, tri.face_tag);
-      if (agrees_with_model(*model, tri.face_tag, x, y, c, hint) &&
-          (!agrees_with_model(*model, tri.face_tag, x, plan.point, c, hint) ||
-           !agrees_with_model(*model, tri.face_tag, plan.point, y, c, hint))) {
+      // Judged as the boundary check will judge the two halves, (x, p, c)
+      // and (p, y, c): projected with the parameters of their last vertex
+      // on the face (the new point's own when it lies on the face).
+      const int f = tri.face_tag;
+      std::optional<Vec2> pp;
+      if (plan.classification == mesh::ModelRef{2, f}) pp = Vec2(plan.param.u, plan.param.v);
+      // The hint of a vertex alone: its parameters if it is on the face.
+      auto own = [&](VertId v) { return check_hint(m, {v, v, v}, f); };
+      auto later = [](std::optional<Vec2> h, std::optional<Vec2> next) { return next ? next : h; };
+      const auto first_half = later(later(own(t[0]), pp), own(t[2]));   // (x, p, c)
+      const auto second_half = later(later(pp, own(t[1])), own(t[2]));  // (p, y, c)
+      if (!agrees_with_model(*model, f, x, plan.point, c, first_half) ||
+          !agrees_with_model(*model, f, plan.point, y, c, second_half)) {
         plan.refusal = Refusal::kFoldedSurface;
         return plan;
       }

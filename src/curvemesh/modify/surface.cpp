@@ -277,6 +277,17 @@ std::optional<Vec2> param_on_face(const mesh::TetMesh& m, const geom::Model* mod
   }
 }
 
+std::optional<Vec2> check_hint(const mesh::TetMesh& m, const std::array<VertId, 3>& verts, int face, VertId moved,
+                               std::optional<Vec2> moved_param) {
+  std::optional<Vec2> hint;
+  for (VertId v : verts) {
+    if (m.vert_class[v] != mesh::ModelRef{2, face}) continue;
+    if (v == moved) hint = moved_param;
+    else hint = Vec2(m.vert_param[v].u, m.vert_param[v].v);
+  }
+  return hint;
+}
+
 bool agrees_with_model(const geom::Model& model, int face, const Vec3& a, const Vec3& b, const Vec3& c,
                        std::optional<Vec2> hint) {
   const geom::Projection p = model.closest_point({2, face}, (a + b + c) / 3, hint);

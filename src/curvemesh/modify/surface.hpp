@@ -91,6 +91,15 @@ std::optional<double> param_on_edge(const mesh::TetMesh& m, const geom::Model* m
 /// good as a hint only). Else nothing.
 std::optional<Vec2> param_on_face(const mesh::TetMesh& m, const geom::Model* model, VertId v, int face);
 
+/// The (u, v) hint generate::check_boundary projects triangle `verts` of
+/// `face` with: the parameters of its last vertex classified on the face
+/// (vertex `moved`, if given, read as having `moved_param`), or none. Fold
+/// tests in the operators use it so that they judge a triangle exactly as the
+/// boundary check will: on a closed, strongly curved face (a torus) the
+/// projection of a coarse triangle's centroid depends on the hint.
+std::optional<Vec2> check_hint(const mesh::TetMesh& m, const std::array<VertId, 3>& verts, int face,
+                               VertId moved = kNone, std::optional<Vec2> moved_param = {});
+
 /// Unnormalized normal of triangle (a, b, c) (right-hand rule).
 inline Vec3 tri_normal(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a); }
 
