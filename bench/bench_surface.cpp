@@ -65,6 +65,7 @@ int main() {
   for (const fs::path& f : files) {
     Row ours, theirs;
     double hmin = 0, hmax = 0;
+    std::string units;
     try {
       const auto model = cm::geom_occ::load_model(f.string());
       const double t0 = now();
@@ -74,6 +75,7 @@ int main() {
       ours.ok = true;
       hmin = sf.hmin;
       hmax = sf.hmax;
+      units = model->units();
       measure(m, ours);
     } catch (const std::exception& e) {
       fmt::print("{:<36} error: {}\n", f.filename().string(), e.what());
@@ -83,8 +85,8 @@ int main() {
       const fs::path out = tmp / (f.stem().string() + "_gmsh.msh");
       const std::string cmd = fmt::format(
           "timeout {} gmsh -2 '{}' -o '{}' -format msh41 -setnumber Mesh.MeshSizeMax {} -setnumber Mesh.MeshSizeMin {} "
-          "-setnumber Mesh.MeshSizeFromCurvature 20 -setnumber General.Verbosity 0 > /dev/null 2>&1",
-          kGmshSeconds, f.string(), out.string(), hmax, hmin);
+          "-setnumber Mesh.MeshSizeFromCurvature 20 -setnumber General.Verbosity 0{} > /dev/null 2>&1",
+          kGmshSeconds, f.string(), out.string(), hmax, hmin, cm::bench::gmsh_unit_option(units));
       const double t0 = now();
       const int rc = std::system(cmd.c_str());
       theirs.seconds = now() - t0;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace cm::bench {
@@ -23,6 +24,20 @@ inline std::vector<std::filesystem::path> model_files() {
   }
   std::sort(files.begin(), files.end());
   return files;
+}
+
+/// The Gmsh option that makes it read a STEP or IGES file in `units` (what
+/// geom::Model::units() reports): Gmsh converts such files to millimetres,
+/// curvemesh keeps the file's own unit, and sizes given to both must mean
+/// the same length. Empty for millimetres and for units OpenCASCADE's
+/// converter does not name (B-rep files carry no unit: both read them as
+/// they are).
+inline std::string gmsh_unit_option(const std::string& units) {
+  static const std::pair<const char*, const char*> kNames[] = {
+      {"cm", "CM"}, {"m", "M"}, {"km", "KM"}, {"um", "UM"}, {"inch", "INCH"}, {"ft", "FT"}, {"mile", "MI"}, {"mil", "MIL"}};
+  for (const auto& [ours, occ] : kNames)
+    if (units == ours) return std::string(" -setstring Geometry.OCCTargetUnit ") + occ;
+  return {};
 }
 
 }  // namespace cm::bench

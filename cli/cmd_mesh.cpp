@@ -100,7 +100,8 @@ int run_mesh(const MeshCliOptions& o) {
                   {"below_0_1_at_small_features", rep.poor_at_small_features},
                   {"percent_edges_in_0_7_1_4", pct_size}};
   j["operations"] = {{"insertions", st.refinement_insertions}, {"flips", st.flips}, {"smoothing", st.smoothing_moves}};
-  j["seconds"] = {{"load", load_s},          {"size_field", size_s},       {"edges", st.edges_seconds},
+  j["seconds"] = {{"load", load_s},          {"size_field", size_s},
+                  {"curvature_sampling", sf.curvature_seconds},        {"edges", st.edges_seconds},
                   {"faces", st.faces_seconds}, {"assembly", st.assembly_seconds}, {"check", check_s},
                   {"write", write_s},        {"total", total.seconds()}};
   if (!o.json_path.empty()) {
@@ -220,6 +221,7 @@ int run_volume(const MeshCliOptions& o) {
                   {"surface_mean", rep.mean_quality}};
   j["seconds"] = {{"load", load_s},
                   {"size_field", size_s},
+                  {"curvature_sampling", sf.curvature_seconds},
                   {"boundary", st.boundary_seconds},
                   {"delaunay", st.delaunay_seconds},
                   {"recovery", st.recovery_seconds},
@@ -259,6 +261,8 @@ int run_volume(const MeshCliOptions& o) {
                "regions {:.2f} s, interior {:.2f} s, optimize {:.2f} s, check {:.2f} s, write {:.2f} s, total {:.2f} s\n",
                load_s, size_s, st.boundary_seconds, st.delaunay_seconds, st.recovery_seconds, st.classify_seconds,
                st.refine_seconds, opt.seconds, check_s, write_s, total.seconds());
+    fmt::print("curvature sampling: {:.3f} s of the size field, {:.1f}% of the total\n", sf.curvature_seconds,
+               100 * sf.curvature_seconds / total.seconds());
     if (!o.output.empty()) fmt::print("wrote {}\n", o.output);
   }
   return ok ? kExitOk : kExitInvalidMesh;

@@ -19,6 +19,7 @@
 #include <TopoDS.hxx>
 #include <gp_Pnt.hxx>
 
+#include "curvemesh/geom_occ/detail/occ_model.hpp"
 #include "curvemesh/geom_occ/load.hpp"
 #include "occ_reference.hpp"
 
@@ -302,6 +303,46 @@ TEST_P(ModelQueries, TrimmedFaceTestPCurvesAndNormalsAgreeWithOcc) {
   EXPECT_EQ(pcurve_gaps, 0);
   EXPECT_EQ(loop_sense, 0);
   EXPECT_EQ(wrong_side, 0) << "of " << sided;
+}
+
+// contains_param answers from the loops' polygons away from them and asks
+// OCC's classifier near them: it must give OCC's answer everywhere, and the
+// polygons must serve nearly every face. Points uniformly in each face's
+// (u, v) box, and close to its p-curves, where a misread band would show.
+TEST_P(ModelQueries, TrimPolygonsGiveTheClassifiersAnswer) {
+  const auto loaded = load_model(GetParam());
+  const auto* model = dynamic_cast<const detail::OccModel*>(loaded.get());
+  ASSERT_NE(model, nullptr);
+  const int nf = model->count(2);
+  EXPECT_GE(model->faces_with_trim_polygons(), nf * 9 / 10) << "of " << nf << " faces";
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const int per_face = std::clamp(30000 / nf, 40, 2000);
+  int differ = 0, checked = 0;
+  for (int face = 1; face <= nf; ++face) {
+    const geom::ParamRange r = model->param_range({2, face});
+    const double extent = std::max(r.u1 - r.u0, r.v1 - r.v0);
+    std::vector<Vec2> points;
+    for (int i = 0; i < per_face; ++i)
+      points.emplace_back(r.u0 + unit(rng) * (r.u1 - r.u0), r.v0 + unit(rng) * (r.v1 - r.v0));
+    for (const geom::Loop& loop : model->face_loops(face))
+      for (const geom::OrientedUse& use : loop.edges) {
+        const geom::ParamRange er = model->param_range({1, use.tag});
+        for (int i = 0; i < 20; ++i) {
+          const double u = er.u0 + unit(rng) * (er.u1 - er.u0);
+          const Vec2 uv = model->edge_param_on_face(use.tag, face, u, use.forward);
+          const double off = i == 0 ? 0.0 : extent * std::pow(10.0, -11 + 10 * unit(rng));
+          const double angle = 6.283185307179586 * unit(rng);
+          points.push_back(uv + off * Vec2(std::cos(angle), std::sin(angle)));
+        }
+      }
+    for (const Vec2& uv : points) {
+      ++checked;
+      if (model->contains_param(face, uv) == model->contains_param_by_occ(face, uv)) continue;
+      if (++differ <= 5) ADD_FAILURE() << "face " << face << " (" << uv.x() << ", " << uv.y() << ")";
+    }
+  }
+  EXPECT_EQ(differ, 0) << "of " << checked;
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, ModelQueries, ::testing::ValuesIn(test::model_files()), test_name);

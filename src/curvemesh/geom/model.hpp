@@ -180,6 +180,13 @@ class Model {
   virtual Vec2 edge_param_on_face(int edge, int face, double u, bool forward = true) const = 0;
   /// Whether (u, v) is inside the trimmed face (on its boundary counts as in).
   virtual bool contains_param(int face, const Vec2& uv) const = 0;
+  /// The same test for callers that may take a point very near the face's
+  /// boundary as on it (a curvature sampler, whose sample there reads the
+  /// surface the face is cut from): the answer where it is quick to tell,
+  /// nullopt in a narrow band along the trimming loops (a few thousandths of
+  /// the parameter extent at most) where only contains_param can. The
+  /// default gives contains_param's answer everywhere.
+  virtual std::optional<bool> contains_param_quick(int face, const Vec2& uv) const { return contains_param(face, uv); }
   /// Where x lies with respect to the closed solid `region`: kOn within
   /// tolerance({3, region}) of its boundary (so a point of a face two
   /// regions share is kOn for both), else kInside or kOutside. Exact to

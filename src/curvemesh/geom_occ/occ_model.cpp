@@ -288,6 +288,7 @@ void OccModel::build_faces(const TopoDS_Shape& shape, const ShapeMaps& maps) {
                                 1e-3 * std::max(r.u1 - r.u0, r.v1 - r.v0));
     d.classifier = std::make_unique<BRepTopAdaptor_FClass2d>(
         TopoDS::Face(d.face.Oriented(TopAbs_FORWARD)), d.uv_tolerance);
+    d.trim = build_trim_classifier(d, edges_);
     build_face_samples(d);
   }
   // Region uses: forward when the region sees the face as its first region does.
@@ -443,15 +444,25 @@ void OccModel::build_face_samples(FaceData& d) {
   }
   const geom::ParamRange& r = d.range;
   d.grid_step = Vec2((r.u1 - r.u0) / nu, (r.v1 - r.v0) / nv);
+  // The grid is classified by OCC, which also checks the trim polygons
+  // across the face's interior (build_trim_classifier checked them near the
+  // loops).
+  bool trim_agrees = true;
   for (int i = 0; i < nu; ++i) {
     for (int j = 0; j < nv; ++j) {
       const Vec2 uv(r.u0 + (r.u1 - r.u0) * (i + 0.5) / nu, r.v0 + (r.v1 - r.v0) * (j + 0.5) / nv);
-      if (!face_contains(d, uv)) continue;
+      const bool in = occ_face_contains(d, uv);
+      if (d.trim) {
+        const auto fast = trim_face_contains(d, *d.trim, uv);
+        trim_agrees &= !fast || *fast == in;
+      }
+      if (!in) continue;
       d.sample_params.push_back(uv);
       d.sample_points.push_back(to_vec(d.surface->Value(uv.x(), uv.y())));
     }
   }
   d.grid_samples = d.sample_points.size();
+  if (!trim_agrees) d.trim.reset();
   // Box: a face's extreme coordinates are on its boundary (the edges' exact
   // boxes) or at interior critical points, found by ascent from the best
   // grid sample. A plane needs only its edges.

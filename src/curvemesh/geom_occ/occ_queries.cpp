@@ -187,18 +187,5 @@ bool OccModel::contains_param(int face, const Vec2& uv) const {
   return face_contains(face_at(face), uv);
 }
 
-bool face_contains(const FaceData& f, Vec2 uv) {
-  if (!std::isfinite(uv.x()) || !std::isfinite(uv.y())) return false;
-  // The classifier brings periodic parameters into range one period at a
-  // time: do it in one step.
-  const geom::ParamRange& r = f.range;
-  if (r.periodic_u && (uv.x() < r.u0 || uv.x() > r.u0 + r.period_u))
-    uv.x() -= std::floor((uv.x() - r.u0) / r.period_u) * r.period_u;
-  if (r.periodic_v && (uv.y() < r.v0 || uv.y() > r.v0 + r.period_v))
-    uv.y() -= std::floor((uv.y() - r.v0) / r.period_v) * r.period_v;
-  // ON (within the classifier's band, FaceData::uv_tolerance) counts as in.
-  const std::lock_guard<std::mutex> lock(*f.classifier_mutex);
-  return f.classifier->Perform(gp_Pnt2d(uv.x(), uv.y()), true) != TopAbs_OUT;
-}
 
 }  // namespace cm::geom_occ::detail

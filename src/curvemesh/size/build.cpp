@@ -115,6 +115,7 @@ SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& o)
   so.hmin = r.hmin;
   so.hmax = r.hmax;
   r.samples = sample_model_curvature(model, so, &r.stats);
+  r.curvature_seconds = timer.seconds();
   if (o.directional)
     for (SizeSample& sm : r.samples)
       if (sm.source == SizeSource::kFaceCurvature)

@@ -92,7 +92,7 @@ class FaceSampler {
     nu_ = o_.grid_cells > 0 ? o_.grid_cells : cells_for(face_extent(m_, face_, pr_, true), spacing, 2, o_.max_grid_cells);
     nv_ = o_.grid_cells > 0 ? o_.grid_cells : cells_for(face_extent(m_, face_, pr_, false), spacing, 2, o_.max_grid_cells);
     for (int i = 0; i < nu_; ++i)
-      for (int j = 0; j < nv_; ++j) visit_cell(i * res_, j * res_, res_, 0);
+      for (int j = 0; j < nv_; ++j) visit_cell(i * res_, j * res_, res_, 0, false);
     return std::move(out_);
   }
 
@@ -118,7 +118,11 @@ class FaceSampler {
     }
     const Vec2 uv = param(i, j);
     Point p{Vec3::Zero(), std::numeric_limits<double>::infinity(), false};
-    if (!known_inside && !m_.contains_param(face_, uv)) {
+    // Near the trimming loops a sample counts as on the face: just off it,
+    // it reads the curvature of the surface the face is cut from, next to
+    // the face's own. Grid corners on the parameter box's edges are many,
+    // and are exactly where telling in from out is slow.
+    if (!known_inside && !m_.contains_param_quick(face_, uv).value_or(true)) {
       ++st_.outside;
       p.x = m_.face_point(face_, uv);
     } else {
@@ -138,18 +142,21 @@ class FaceSampler {
     return seen_.emplace(key, p).first->second;
   }
 
-  void visit_cell(std::int64_t i0, std::int64_t j0, std::int64_t s, int depth) {
+  // `in_parent`: the four corners of the cell this one was cut from are in
+  // the face, so this cell's points are taken as in it too.
+  void visit_cell(std::int64_t i0, std::int64_t j0, std::int64_t s, int depth, bool in_parent) {
     // Copies: eval() may rehash the map.
-    const Point c00 = eval(i0, j0), c10 = eval(i0 + s, j0), c01 = eval(i0, j0 + s), c11 = eval(i0 + s, j0 + s);
+    const Point c00 = eval(i0, j0, in_parent), c10 = eval(i0 + s, j0, in_parent), c01 = eval(i0, j0 + s, in_parent),
+                c11 = eval(i0 + s, j0 + s, in_parent);
     double need = std::min({c00.size, c10.size, c01.size, c11.size});
-    // A centroid between four corners in the face is taken as in it too: it
-    // is wrong only inside a hole smaller than the cell, where the sample
-    // then reads the curvature of the surface the hole was cut from, next
-    // to the face's own, which can only make the field finer there.
-    if (o_.centroids) {
-      const bool inside = c00.inside && c10.inside && c01.inside && c11.inside;
-      need = std::min(need, eval(i0 + s / 2, j0 + s / 2, inside).size);
-    }
+    // A point between four corners in the face (the centroid, the points of
+    // a subdivision) is taken as in it too: it is wrong only inside a hole
+    // smaller than the cell, where the sample then reads the curvature of
+    // the surface the hole was cut from, next to the face's own, which can
+    // only make the field finer there. The trimming test is most of the cost
+    // of a sample on CAD faces.
+    const bool inside = c00.inside && c10.inside && c01.inside && c11.inside;
+    if (o_.centroids) need = std::min(need, eval(i0 + s / 2, j0 + s / 2, inside).size);
     if (!o_.adaptive || depth >= o_.max_depth || s < 2 || !std::isfinite(need)) return;
     const double diameter = std::max((c11.x - c00.x).norm(), (c10.x - c01.x).norm());
     if (!(need < diameter) || diameter <= o_.hmin) return;
@@ -166,7 +173,7 @@ class FaceSampler {
     ++st_.subdivided;
     const std::int64_t h = s / 2;
     for (int a = 0; a < 2; ++a)
-      for (int b = 0; b < 2; ++b) visit_cell(i0 + a * h, j0 + b * h, h, depth + 1);
+      for (int b = 0; b < 2; ++b) visit_cell(i0 + a * h, j0 + b * h, h, depth + 1, inside);
   }
 
   const geom::Model& m_;

@@ -44,6 +44,7 @@
 
 #include "curvemesh/geom/model.hpp"
 #include "curvemesh/geom_occ/detail/triangle_classifier.hpp"
+#include "curvemesh/geom_occ/detail/trim_classifier.hpp"
 
 namespace cm::geom_occ::detail {
 
@@ -113,6 +114,9 @@ struct FaceData {
   // through face_contains, which holds classifier_mutex.
   std::unique_ptr<BRepTopAdaptor_FClass2d> classifier;
   std::unique_ptr<std::mutex> classifier_mutex = std::make_unique<std::mutex>();
+  // The fast path in front of it (occ_trim.cpp): the loops as polygons;
+  // null where they could not be built or disagreed with the classifier.
+  std::unique_ptr<TrimClassifier> trim;
   std::vector<geom::Loop> loops;
   std::vector<int> edges;  // boundary edges, each once
   std::vector<PCurveUse> pcurves;
@@ -162,8 +166,19 @@ struct RegionData {
   std::unique_ptr<ClassifierPool> classifiers = std::make_unique<ClassifierPool>();
 };
 
-/// contains_param on a face's data (occ_queries.cpp).
+/// contains_param on a face's data: the polygons first, OCC's classifier
+/// within their band (occ_trim.cpp).
 bool face_contains(const FaceData& face, Vec2 uv);
+/// OCC's classifier alone (uv in the face's periodic range).
+bool occ_face_contains(const FaceData& face, const Vec2& uv);
+/// The polygons of the face's loops, checked against OCC's classifier just
+/// outside their band; nullptr when a p-curve is missing or a check fails.
+/// Needs the face's loops, p-curves and uv tolerances.
+std::unique_ptr<TrimClassifier> build_trim_classifier(const FaceData& face, const std::vector<EdgeData>& edges);
+/// What `trim` (the face's polygons) says of uv as face_contains would ask
+/// it (periodic parameters brought into range, shifts by a period tried);
+/// nullopt where OCC's classifier must decide.
+std::optional<bool> trim_face_contains(const FaceData& face, const TrimClassifier& trim, const Vec2& uv);
 
 /// Adds to `box` the interior maxima and minima of each coordinate over the
 /// trimmed face (occ_bounds.cpp); the boundary is the edges' business.
@@ -203,7 +218,14 @@ class OccModel final : public geom::Model {
                                  std::optional<Vec2> hint = {}) const override;
   Vec2 edge_param_on_face(int edge, int face, double u, bool forward = true) const override;
   bool contains_param(int face, const Vec2& uv) const override;
+  std::optional<bool> contains_param_quick(int face, const Vec2& uv) const override;
   geom::Containment classify_point(int region, const Vec3& x) const override;
+
+  /// Faces whose contains_param has the polygon fast path (for tests and
+  /// benchmarks: the rest always ask OCC's classifier).
+  int faces_with_trim_polygons() const;
+  /// contains_param by OCC's classifier alone, without the fast path.
+  bool contains_param_by_occ(int face, const Vec2& uv) const;
 
   double area(int face) const override;
   double length(int edge) const override;
