@@ -17,6 +17,7 @@
 #include "curvemesh/optimize/improve.hpp"
 #include "curvemesh/quality/measures.hpp"
 #include "curvemesh/quality/statistics.hpp"
+#include "curving.hpp"
 #include "exit_codes.hpp"
 #include "json_output.hpp"
 #include "size_options.hpp"
@@ -33,6 +34,7 @@ struct MeshCliOptions {
   ModelFlags model_flags;
   bool quiet = false;
   bool no_optimize = false;
+  CurvingFlags curving;
 };
 
 // The model and its size field, loaded the same way for both dimensions.
@@ -159,6 +161,13 @@ int run_volume(const MeshCliOptions& o) {
     io.model = model;
     opt = optimize::improve_quality(m, io);
   }
+  std::optional<curved::CurveReport> curving;
+  double curve_s = 0;
+  if (o.curving.order > 1) {
+    step.reset();
+    curving = curved::curve_mesh(m, *model, o.curving.options());
+    curve_s = step.seconds();
+  }
   step.reset();
   const auto valid = mesh::validate(m, mesh::Level::kFull);
   const generate::BoundaryReport rep = generate::check_boundary(*model, m, *sf.field);
@@ -176,7 +185,8 @@ int run_volume(const MeshCliOptions& o) {
   step.reset();
   if (!o.output.empty()) io::write_mesh(m, o.output);
   const double write_s = step.seconds();
-  const bool ok = valid.valid() && rep.vertices_off_entity == 0 && rep.folded_triangles == 0;
+  const bool ok = valid.valid() && rep.vertices_off_entity == 0 && rep.folded_triangles == 0 &&
+                  (!curving || curve_report_ok(*curving));
   const std::size_t steiner = st.recovery.steiner_on_edges + st.recovery.steiner_on_faces;
 
   nlohmann::json j;
@@ -228,9 +238,11 @@ int run_volume(const MeshCliOptions& o) {
                   {"regions", st.classify_seconds},
                   {"interior", st.refine_seconds},
                   {"optimize", opt.seconds},
+                  {"curving", curve_s},
                   {"check", check_s},
                   {"write", write_s},
                   {"total", total.seconds()}};
+  if (curving) j["curving"] = curve_report_json(*curving);
   if (!o.json_path.empty()) write_json(j, o.json_path);
   if (!o.quiet) {
     fmt::print("model: {}  hmin {:.4g}  hmax {:.4g}  curvature {}\n", o.model, sf.hmin, sf.hmax,
@@ -247,7 +259,9 @@ int run_volume(const MeshCliOptions& o) {
                  "< 0.3: {} -> {}; min {:.3f} -> {:.3f}\n",
                  opt.edge_removals, opt.face_swaps, opt.relocations, opt.passes, opt.below_before, opt.below_after,
                  opt.min_before, opt.min_after);
-    fmt::print("quality: mean ratio min {:.3f} mean {:.3f}; min dihedral {:.2f} deg\n", qs.min, qs.mean, ds.min);
+    if (curving) print_curve_report(*curving);
+    fmt::print("quality{}: mean ratio min {:.3f} mean {:.3f}; min dihedral {:.2f} deg\n",
+               curving ? " (straight-sided)" : "", qs.min, qs.mean, ds.min);
     fmt::print("volume: mesh {:.6g}, model {:.6g} (relative difference {:.2e})\n", vol_mesh, vol_model,
                vol_model > 0 ? (vol_mesh - vol_model) / vol_model : 0.0);
     fmt::print("check: {}", ok ? "valid" : "INVALID");
@@ -258,9 +272,11 @@ int run_volume(const MeshCliOptions& o) {
     for (std::size_t i = 0; i < std::min<std::size_t>(valid.issues.size(), 5); ++i)
       fmt::print("  {}\n", valid.issues[i].message);
     fmt::print("time: load {:.2f} s, size field {:.2f} s, boundary {:.2f} s, delaunay {:.2f} s, recovery {:.2f} s, "
-               "regions {:.2f} s, interior {:.2f} s, optimize {:.2f} s, check {:.2f} s, write {:.2f} s, total {:.2f} s\n",
+               "regions {:.2f} s, interior {:.2f} s, optimize {:.2f} s, {}check {:.2f} s, write {:.2f} s, total {:.2f} "
+               "s\n",
                load_s, size_s, st.boundary_seconds, st.delaunay_seconds, st.recovery_seconds, st.classify_seconds,
-               st.refine_seconds, opt.seconds, check_s, write_s, total.seconds());
+               st.refine_seconds, opt.seconds, curving ? fmt::format("curving {:.2f} s, ", curve_s) : "", check_s,
+               write_s, total.seconds());
     fmt::print("curvature sampling: {:.3f} s of the size field, {:.1f}% of the total\n", sf.curvature_seconds,
                100 * sf.curvature_seconds / total.seconds());
     if (!o.output.empty()) fmt::print("wrote {}\n", o.output);
@@ -281,6 +297,7 @@ void add_mesh_command(CLI::App& app, Runner& runner) {
   add_size_flags(cmd, o->size);
   add_model_flags(cmd, o->model_flags);
   cmd->add_flag("--no-optimize", o->no_optimize, "Volume mesh: skip the quality optimization (swaps, smoothing)");
+  add_curving_flags(cmd, o->curving, 1);
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
   cmd->footer(
       "Exit code 0 when the mesh passes its checks (volume: every tet positive, conforming,\n"
@@ -288,7 +305,8 @@ void add_mesh_command(CLI::App& app, Runner& runner) {
       "their entities, no folded triangle, every region closed), 1 when it does not, 2 on bad input,\n"
       "3 on an internal error.\n"
       "\nExamples:\n  curvemesh mesh part.step -o part.msh\n  curvemesh mesh part.step --dim 2 -o part_surface.msh\n"
-      "  curvemesh mesh builtin:torus --dim 2 --curv-eps 0.01 -o torus.vtu");
+      "  curvemesh mesh builtin:torus --dim 2 --curv-eps 0.01 -o torus.vtu\n"
+      "  curvemesh mesh part.step --order 2 -o part_p2.msh");
   cmd->callback([&runner, o] { runner = [o] { return run_mesh(*o); }; });
 }
 

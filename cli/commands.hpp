@@ -23,5 +23,7 @@ void add_mesh_command(CLI::App& app, Runner& runner);
 void add_convert_command(CLI::App& app, Runner& runner);
 /// `curvemesh optimize IN -o OUT [--sol S] [--aniso]`
 void add_optimize_command(CLI::App& app, Runner& runner);
+/// `curvemesh curve MESH --model MODEL --order 2|3 -o OUT`
+void add_curve_command(CLI::App& app, Runner& runner);
 
 }  // namespace cm::cli

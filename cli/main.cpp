@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   add_size_command(app, runner);
   add_mesh_command(app, runner);
   add_optimize_command(app, runner);
+  add_curve_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

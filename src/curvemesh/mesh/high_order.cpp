@@ -121,14 +121,24 @@ void HighOrderNodes::reset(int order) {
   edge_nodes_.clear();
   face_slot_.clear();
   face_nodes_.clear();
+  free_edge_slots_.clear();
+  free_face_slots_.clear();
 }
 
 void HighOrderNodes::set_edge(VertId a, VertId b, std::span<const Vec3> nodes_from_a) {
   const std::size_t n = nodes_per_edge();
   CM_ASSERT_OP(nodes_from_a.size(), ==, n);
   if (n == 0) return;
-  auto [it, inserted] = edge_slot_.try_emplace(edge_key(a, b), static_cast<std::uint32_t>(edge_slot_.size()));
-  if (inserted) edge_nodes_.resize(edge_nodes_.size() + n);
+  auto [it, inserted] = edge_slot_.try_emplace(edge_key(a, b), 0u);
+  if (inserted) {
+    if (!free_edge_slots_.empty()) {
+      it->second = free_edge_slots_.back();
+      free_edge_slots_.pop_back();
+    } else {
+      it->second = static_cast<std::uint32_t>(edge_nodes_.size() / n);
+      edge_nodes_.resize(edge_nodes_.size() + n);
+    }
+  }
   Vec3* dst = edge_nodes_.data() + it->second * n;
   for (std::size_t s = 0; s < n; ++s) dst[a < b ? s : n - 1 - s] = nodes_from_a[s];
 }
@@ -149,12 +159,69 @@ void HighOrderNodes::set_face(VertId a, VertId b, VertId c, std::span<const Vec3
   if (n == 0) return;
   std::array<VertId, 3> s{a, b, c};
   std::sort(s.begin(), s.end());
-  auto [it, inserted] =
-      face_slot_.try_emplace(FaceKey{{s[0], s[1], s[2]}}, static_cast<std::uint32_t>(face_slot_.size()));
-  if (inserted) face_nodes_.resize(face_nodes_.size() + n);
+  auto [it, inserted] = face_slot_.try_emplace(FaceKey{{s[0], s[1], s[2]}}, 0u);
+  if (inserted) {
+    if (!free_face_slots_.empty()) {
+      it->second = free_face_slots_.back();
+      free_face_slots_.pop_back();
+    } else {
+      it->second = static_cast<std::uint32_t>(face_nodes_.size() / n);
+      face_nodes_.resize(face_nodes_.size() + n);
+    }
+  }
   Vec3* dst = face_nodes_.data() + it->second * n;
   const auto perm = face_permutation(order_, {a, b, c});
   for (std::size_t k = 0; k < n; ++k) dst[perm[k]] = nodes[k];
+}
+
+void HighOrderNodes::remap_vertices(std::span<const VertId> old2new) {
+  // Order-preserving renaming keeps each key's sorted order, so the stored
+  // node order (relative to the sorted vertices) stays right.
+  std::unordered_map<std::uint64_t, std::uint32_t> edges;
+  for (const auto& [key, slot] : edge_slot_) {
+    const VertId a = old2new[key >> 32], b = old2new[key & 0xffffffffu];
+    if (a == kNone || b == kNone)
+      free_edge_slots_.push_back(slot);
+    else
+      edges.emplace(edge_key(a, b), slot);
+  }
+  edge_slot_ = std::move(edges);
+  std::unordered_map<FaceKey, std::uint32_t, FaceKeyHash> faces;
+  for (const auto& [key, slot] : face_slot_) {
+    const VertId a = old2new[key.v[0]], b = old2new[key.v[1]], c = old2new[key.v[2]];
+    if (a == kNone || b == kNone || c == kNone)
+      free_face_slots_.push_back(slot);
+    else
+      faces.emplace(FaceKey{{a, b, c}}, slot);
+  }
+  face_slot_ = std::move(faces);
+}
+
+bool HighOrderNodes::has_edge(VertId a, VertId b) const {
+  return nodes_per_edge() > 0 && edge_slot_.count(edge_key(a, b)) > 0;
+}
+
+bool HighOrderNodes::has_face(VertId a, VertId b, VertId c) const {
+  if (nodes_per_face() == 0) return false;
+  std::array<VertId, 3> s{a, b, c};
+  std::sort(s.begin(), s.end());
+  return face_slot_.count(FaceKey{{s[0], s[1], s[2]}}) > 0;
+}
+
+void HighOrderNodes::erase_edge(VertId a, VertId b) {
+  const auto it = edge_slot_.find(edge_key(a, b));
+  if (it == edge_slot_.end()) return;
+  free_edge_slots_.push_back(it->second);
+  edge_slot_.erase(it);
+}
+
+void HighOrderNodes::erase_face(VertId a, VertId b, VertId c) {
+  std::array<VertId, 3> s{a, b, c};
+  std::sort(s.begin(), s.end());
+  const auto it = face_slot_.find(FaceKey{{s[0], s[1], s[2]}});
+  if (it == face_slot_.end()) return;
+  free_face_slots_.push_back(it->second);
+  face_slot_.erase(it);
 }
 
 bool HighOrderNodes::get_face(VertId a, VertId b, VertId c, Vec3* out) const {
@@ -250,6 +317,10 @@ void scatter_nodes(TetMesh& m, const std::array<VertId, K>& v,
 
 std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t) {
   return gather_nodes<4>(m, m.tet2verts[t], cached_tet_indices(m.high_order.order()));
+}
+
+std::vector<Vec3> gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts) {
+  return gather_nodes<4>(m, verts, cached_tet_indices(m.high_order.order()));
 }
 
 std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri) {

@@ -46,6 +46,17 @@ class HighOrderNodes {
   void set_face(VertId a, VertId b, VertId c, std::span<const Vec3> nodes);
   bool get_face(VertId a, VertId b, VertId c, Vec3* out) const;
 
+  bool has_edge(VertId a, VertId b) const;
+  bool has_face(VertId a, VertId b, VertId c) const;
+  /// Forgets the nodes of edge (a,b) / face (a,b,c), which become straight.
+  /// No effect when none are stored. Their slots are reused by later sets.
+  void erase_edge(VertId a, VertId b);
+  void erase_face(VertId a, VertId b, VertId c);
+
+  /// Renames vertices by old2new, which must keep their order (as a
+  /// compaction does); entries on a vertex mapped to kNone are dropped.
+  void remap_vertices(std::span<const VertId> old2new);
+
   std::size_t num_edges() const { return edge_slot_.size(); }
   std::size_t num_faces() const { return face_slot_.size(); }
   std::size_t nodes_per_edge() const { return order_ > 1 ? order_ - 1 : 0; }
@@ -74,6 +85,9 @@ class HighOrderNodes {
   std::vector<Vec3> edge_nodes_;
   std::unordered_map<FaceKey, std::uint32_t, FaceKeyHash> face_slot_;
   std::vector<Vec3> face_nodes_;
+  // Slots of erased entries, reused first: curving repairs erase and set
+  // nodes many times over.
+  std::vector<std::uint32_t> free_edge_slots_, free_face_slots_;
 };
 
 struct TetMesh;
@@ -81,6 +95,9 @@ struct TetMesh;
 /// All nodes of tet t in the internal order of tet_node_indices(order): stored
 /// edge/face nodes where present, linear interpolation elsewhere.
 std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t);
+/// The same for a tet given by its vertices (it need not be in the mesh: a
+/// tet an operator would create).
+std::vector<Vec3> gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts);
 /// All nodes of triangle (a,b,c) in the order of tri_node_indices(order).
 std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri);
 

@@ -36,4 +36,40 @@ double tet_volume(const TetMesh& m, TetId t) {
   return (m.coords[v[1]] - a).cross(m.coords[v[2]] - a).dot(m.coords[v[3]] - a) / 6.0;
 }
 
+std::vector<VertId> drop_unused_vertices(TetMesh& m) {
+  const std::size_t nv = m.num_verts();
+  std::vector<VertId> old2new(nv, kNone);
+  for (const auto& tv : m.tet2verts)
+    for (VertId v : tv)
+      if (v != kNone) old2new[v] = 0;
+  VertId next = 0;
+  for (VertId v = 0; v < nv; ++v)
+    if (old2new[v] != kNone) old2new[v] = next++;
+  if (next == nv) {
+    for (VertId v = 0; v < nv; ++v) old2new[v] = v;
+    return old2new;
+  }
+  const bool seeds = m.vert2tet.size() == nv;
+  for (VertId v = 0; v < nv; ++v) {
+    const VertId w = old2new[v];
+    if (w == kNone) continue;
+    m.coords[w] = m.coords[v];
+    if (v < m.vert_class.size()) m.vert_class[w] = m.vert_class[v];
+    if (v < m.vert_param.size()) m.vert_param[w] = m.vert_param[v];
+    if (seeds) m.vert2tet[w] = m.vert2tet[v];
+  }
+  m.coords.resize(next);
+  if (m.vert_class.size() == nv) m.vert_class.resize(next);
+  if (m.vert_param.size() == nv) m.vert_param.resize(next);
+  if (seeds) m.vert2tet.resize(next);
+  for (auto& tv : m.tet2verts)
+    for (VertId& v : tv) v = old2new[v];
+  for (auto& t : m.tris)
+    for (VertId& v : t.verts) v = old2new[v];
+  for (auto& e : m.edges)
+    for (VertId& v : e.verts) v = old2new[v];
+  m.high_order.remap_vertices(old2new);
+  return old2new;
+}
+
 }  // namespace cm::mesh

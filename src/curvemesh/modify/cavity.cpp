@@ -138,7 +138,7 @@ std::span<const TetId> rebuild(MeshEditor& ed, Cavity& cav, std::span<const NewT
     const TetId s = m.vert2tet[v];
     if (s != kNone && (ed.is_dead(s) || mesh::local_index(m, s, v) < 0)) m.vert2tet[v] = kNone;
   }
-  if (ed.hook()) ed.hook()(m, cav.created_);
+  ed.notify(cav.created_);
   return cav.created_;
 }
 
@@ -310,7 +310,7 @@ std::span<const TetId> fill_star(MeshEditor& ed, Cavity& cav, VertId p) {
     for (int k = 0; k < 3; ++k) cav.side_[3 * i + k] = mesh::pack_face(t, mesh::kFaceVerts[fb][k]);
   }
   if (!link_star_by_local_edges(m, cav)) link_star_by_hashed_edges(m, cav);
-  if (ed.hook()) ed.hook()(m, cav.created_);
+  ed.notify(cav.created_);
   return cav.created_;
 }
 

@@ -254,6 +254,8 @@ CollapsePlan plan_collapse(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
 }
 
 std::span<const TetId> apply(MeshEditor& ed, Cavity& cav, BoundaryIndex& surf, const CollapsePlan& plan) {
+  // The hook runs once m.tris and m.edges follow the collapse too.
+  const MeshEditor::DeferredHook defer(ed);
   auto& m = ed.mesh();
   const VertId a = plan.from, b = plan.to;
   thread_local std::vector<NewTet> fill;

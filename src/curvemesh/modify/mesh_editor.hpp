@@ -107,6 +107,31 @@ class MeshEditor {
   void set_hook(RebuildHook hook) { hook_ = std::move(hook); }
   const RebuildHook& hook() const { return hook_; }
 
+  /// What the kernel calls after a rebuild: the hook with the created tets,
+  /// or, while a DeferredHook is alive, nothing yet (the tets are kept).
+  void notify(std::span<const TetId> created) {
+    if (!hook_) return;
+    if (deferrals_ > 0)
+      deferred_.insert(deferred_.end(), created.begin(), created.end());
+    else
+      hook_(*m_, created);
+  }
+
+  /// Holds the hook back for the life of the object, then calls it once
+  /// with every tet created meanwhile that is still live. Operators that
+  /// edit m.tris / m.edges after their rebuild hold it, so the hook sees the
+  /// finished edit (curving classifies the new entities by those arrays).
+  class DeferredHook {
+   public:
+    explicit DeferredHook(MeshEditor& ed) : ed_(ed) { ++ed_.deferrals_; }
+    DeferredHook(const DeferredHook&) = delete;
+    DeferredHook& operator=(const DeferredHook&) = delete;
+    ~DeferredHook();
+
+   private:
+    MeshEditor& ed_;
+  };
+
   /// Removes dead tets (renumbering the rest in order), rebuilds vert2tet;
   /// returns old id -> new id (kNone for dead). Invalidates stamps.
   std::vector<TetId> compact();
@@ -132,6 +157,8 @@ class MeshEditor {
   std::uint32_t epoch_ = 1;
   bool seeds_deferred_ = false;
   RebuildHook hook_;
+  int deferrals_ = 0;
+  std::vector<TetId> deferred_;
 };
 
 }  // namespace cm::modify

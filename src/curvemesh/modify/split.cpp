@@ -203,6 +203,8 @@ SplitPlan plan_split(MeshEditor& ed, Cavity& cav, const BoundaryIndex& surf, Ver
 }
 
 VertId apply(MeshEditor& ed, Cavity& cav, BoundaryIndex& surf, const SplitPlan& plan) {
+  // The hook runs once m.tris and m.edges are split too.
+  const MeshEditor::DeferredHook defer(ed);
   auto& m = ed.mesh();
   const VertId a = plan.a, b = plan.b;
   const VertId p = m.add_vert(plan.point);

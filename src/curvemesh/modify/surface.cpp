@@ -239,7 +239,7 @@ std::span<const TetId> rebuild_open(MeshEditor& ed, Cavity& cav, std::span<const
           break;
         }
     }
-  if (ed.hook()) ed.hook()(m, created);
+  ed.notify(created);
   return created;
 }
 

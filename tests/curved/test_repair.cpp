@@ -1,0 +1,187 @@
+// Validity checks of curved tets and the repair (curved/element_check.hpp,
+// curved/repair.hpp, curved/curve.hpp): known-invalid elements flagged at
+// the right place, and coarse meshes of curved models that curving breaks
+// ending with every element certified valid and acceptable, the mesh still
+// a geometric triangulation of its model, the node storage exactly the
+// boundary's, and the same result for any thread count.
+#include <set>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "curved_support.hpp"
+#include "curvemesh/generate/boundary_check.hpp"
+#include "curvemesh/mesh/high_order.hpp"
+#include "curvemesh/mesh/topology.hpp"
+#include "curvemesh/mesh/validate.hpp"
+#include "curvemesh/quality/shape_measure.hpp"
+#include "curvemesh/size/size_field.hpp"
+
+namespace cm::test {
+namespace {
+
+std::vector<Vec3> straight_p2(const std::array<Vec3, 4>& v) {
+  std::vector<Vec3> n(v.begin(), v.end());
+  for (const auto& e : mesh::kTetEdges) n.push_back(0.5 * (v[e[0]] + v[e[1]]));
+  return n;
+}
+
+const std::array<Vec3, 4> kUnit{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+
+TEST(ElementCheck, StraightTetIsValidAndAcceptable) {
+  const auto c = curved::check_element(2, straight_p2(kUnit), {});
+  EXPECT_EQ(c.verdict, quality::Validity::kValid);
+  EXPECT_TRUE(c.acceptable);
+  EXPECT_DOUBLE_EQ(c.scaled_jacobian, 1);
+  std::array<Vec3, 4> flipped = kUnit;
+  std::swap(flipped[1], flipped[2]);
+  const auto f = curved::check_element(2, straight_p2(flipped), {});
+  EXPECT_EQ(f.verdict, quality::Validity::kInvalid);
+  EXPECT_FALSE(f.acceptable);
+}
+
+TEST(ElementCheck, EdgeBentThroughTheOppositeFaceIsInvalidThere) {
+  // The midpoint of edge (0, 1) pushed far past the face (1, 2, 3): det J
+  // changes sign near that edge.
+  auto n = straight_p2(kUnit);
+  n[4] = Vec3(0.5, 1.2, 1.2);
+  const auto c = curved::check_element(2, n, {});
+  EXPECT_EQ(c.verdict, quality::Validity::kInvalid);
+  EXPECT_FALSE(c.acceptable);
+  EXPECT_LT(c.score(), 0);
+  // Least det J on edge 0 or at one of its ends.
+  const bool on_edge = c.where.dim == 1 && c.where.index == 0;
+  const bool at_end = c.where.dim == 0 && (c.where.index == 0 || c.where.index == 1);
+  EXPECT_TRUE(on_edge || at_end) << c.where.dim << "/" << c.where.index;
+  // A mild bend is valid but below a demanding threshold.
+  n[4] = Vec3(0.5, 0.05, 0.05);
+  const auto mild = curved::check_element(2, n, {});
+  EXPECT_EQ(mild.verdict, quality::Validity::kValid);
+  EXPECT_LT(mild.scaled_jacobian, 1);
+  curved::Acceptance strict;
+  strict.min_scaled_jacobian = 0.99;
+  EXPECT_FALSE(curved::check_element(2, n, strict).acceptable);
+}
+
+// Boundary edges of m (edges of its triangles and its classified edges).
+std::set<std::pair<VertId, VertId>> boundary_edges(const mesh::TetMesh& m) {
+  std::set<std::pair<VertId, VertId>> out;
+  auto add = [&](VertId a, VertId b) { out.insert({std::min(a, b), std::max(a, b)}); };
+  for (const auto& t : m.tris)
+    for (const auto& e : mesh::kTriEdges) add(t.verts[e[0]], t.verts[e[1]]);
+  for (const auto& e : m.edges) add(e.verts[0], e.verts[1]);
+  return out;
+}
+
+struct Case {
+  const char* name;
+  const char* spec;
+  int order;
+  bool expect_problems;  ///< curving makes some tets unacceptable before repair
+};
+
+class Repair : public ::testing::TestWithParam<Case> {};
+
+TEST_P(Repair, EveryElementEndsCertifiedValidAndAcceptable) {
+  const Case& c = GetParam();
+  Meshed r = mesh_for_curving(c.spec, 0.25);
+  curved::CurveOptions o;
+  o.order = c.order;
+  const curved::CurveReport rep = curved::curve_mesh(r.m, *r.model, o);
+  if (c.expect_problems) {
+    EXPECT_GT(rep.unacceptable_before, 0u);
+  }
+  EXPECT_EQ(rep.after.invalid.size(), 0u);
+  EXPECT_EQ(rep.after.unacceptable.size(), 0u);
+  EXPECT_GE(rep.after.min_scaled_jacobian, o.repair.acceptance.min_scaled_jacobian);
+  EXPECT_GE(rep.after.min_measure, o.repair.acceptance.min_measure);
+  // Certified again from scratch, through the quality module directly.
+  for (TetId t = 0; t < r.m.num_tets(); ++t)
+    ASSERT_EQ(quality::certify_tet(r.m, t).verdict, quality::Validity::kValid) << "tet " << t;
+  // Still a geometric triangulation of the model.
+  const auto v = mesh::validate(r.m, mesh::Level::kFull);
+  EXPECT_TRUE(v.valid()) << (v.issues.empty() ? "" : v.issues.front().message);
+  const size::UniformSizeField field(r.model->bounding_box().diagonal() / 20);
+  const auto b = generate::check_boundary(*r.model, r.m, field);
+  EXPECT_EQ(b.vertices_off_entity, 0u);
+  EXPECT_EQ(b.folded_triangles, 0u);
+  // The node storage: every boundary edge (and order-3 triangle) has nodes;
+  // the only other edges with nodes are the ones the repair curved inside.
+  const auto boundary = boundary_edges(r.m);
+  std::set<std::pair<VertId, VertId>> interior_with_nodes;
+  for (const auto& tv : r.m.tet2verts)
+    for (const auto& e : mesh::kTetEdges) {
+      const std::pair<VertId, VertId> k{std::min(tv[e[0]], tv[e[1]]), std::max(tv[e[0]], tv[e[1]])};
+      const bool has = r.m.high_order.has_edge(k.first, k.second);
+      if (boundary.count(k))
+        ASSERT_TRUE(has) << "boundary edge " << k.first << "-" << k.second << " has no nodes";
+      else if (has)
+        interior_with_nodes.insert(k);
+    }
+  EXPECT_EQ(interior_with_nodes.size(), rep.repair.interior_edges_curved);
+  if (c.order == 3) {
+    for (const auto& t : r.m.tris) ASSERT_TRUE(r.m.high_order.has_face(t.verts[0], t.verts[1], t.verts[2]));
+  }
+  // Boundary nodes are on the model, but where step 5 straightened edges.
+  const double scale = r.model->bounding_box().diagonal();
+  std::size_t off = 0;
+  for (const auto& t : r.m.tris)
+    for (const auto& e : mesh::kTriEdges) {
+      std::array<Vec3, 2> n;
+      r.m.high_order.get_edge(t.verts[e[0]], t.verts[e[1]], n.data());
+      for (int s = 0; s < c.order - 1; ++s) off += r.model->closest_point({2, t.face_tag}, n[s]).distance > 1e-7 * scale;
+    }
+  // Each straightened edge is seen from its (at most two) triangles.
+  EXPECT_LE(off, 2 * (c.order - 1) * rep.repair.edges_straightened);
+  // Curving brings the boundary closer to the model.
+  EXPECT_LT(rep.error_curved.mean, 0.5 * rep.error_straight.mean);
+}
+
+const Case kCases[] = {
+    {"HolesP2", "builtin:holes", 2, true},        {"HolesP3", "builtin:holes", 3, true},
+    {"ThinWallP2", "builtin:thinwall", 2, true},  {"ThinWallP3", "builtin:thinwall", 3, true},
+    {"TorusP2", "builtin:torus", 2, true},        {"TorusP3", "builtin:torus", 3, true},
+    {"PartP3", "builtin:part", 3, true},          {"RingP2", "ring.brep", 2, true},
+    {"RingP3", "ring.brep", 3, true},             {"TorusCadP3", "Torus_1.brep", 3, true},
+    {"SphereP2", "builtin:sphere", 2, false},      {"InclusionP3", "builtin:inclusion", 3, false},
+};
+
+INSTANTIATE_TEST_SUITE_P(Models, Repair, ::testing::ValuesIn(kCases),
+                         [](const testing::TestParamInfo<Case>& param_info) { return std::string(param_info.param.name); });
+
+// Curved tets bound the model's volume far better than straight ones:
+// sphere of radius 1, volume by a quadrature exact for each element.
+TEST(Curving, VolumeOfACurvedSphereMeshIsCloseToTheSpheres) {
+  for (int order : {2, 3}) {
+    Meshed r = mesh_for_curving("builtin:sphere", 0.1);
+    double straight = 0;
+    for (TetId t = 0; t < r.m.num_tets(); ++t) straight += mesh::tet_volume(r.m, t);
+    curved::CurveOptions o;
+    o.order = order;
+    curved::curve_mesh(r.m, *r.model, o);
+    double curved = 0;
+    for (TetId t = 0; t < r.m.num_tets(); ++t) curved += quality::shape_measure(r.m, t).volume;
+    const double exact = 4.0 / 3 * std::numbers::pi;
+    EXPECT_LT(std::abs(curved - exact), 0.02 * std::abs(straight - exact)) << "order " << order;
+  }
+}
+
+TEST(Curving, ResultDoesNotDependOnTheThreadCount) {
+  auto run = [](int threads) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    Meshed r = mesh_for_curving("builtin:holes", 0.25);
+    curved::CurveOptions o;
+    o.order = 2;
+    curved::curve_mesh(r.m, *r.model, o);
+    return r.m;
+  };
+  const mesh::TetMesh a = run(1), b = run(2);
+  ASSERT_EQ(a.num_tets(), b.num_tets());
+  ASSERT_EQ(a.num_verts(), b.num_verts());
+  EXPECT_EQ(a.tet2verts, b.tet2verts);
+  EXPECT_EQ(a.coords, b.coords);
+  for (TetId t = 0; t < a.num_tets(); ++t) ASSERT_EQ(mesh::gather_tet_nodes(a, t), mesh::gather_tet_nodes(b, t));
+}
+
+}  // namespace
+}  // namespace cm::test
