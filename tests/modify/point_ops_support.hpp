@@ -27,13 +27,17 @@ struct MeshedModel {
   mesh::TetMesh m;
 };
 
-inline MeshedModel mesh_model(const std::string& spec, double hmax) {
+/// `refine` false: the tets of the boundary points alone (many against the
+/// hull with two or three faces there).
+inline MeshedModel mesh_model(const std::string& spec, double hmax, bool refine = true) {
   MeshedModel r;
   r.model = geom_occ::load_model(spec);
   size::SizeOptions so;
   so.hmax = hmax;
   r.size = size::build_size_field(*r.model, so);
-  r.m = generate::mesh_volume(*r.model, *r.size.field);
+  generate::VolumeMeshOptions vo;
+  vo.refine = refine;
+  r.m = generate::mesh_volume(*r.model, *r.size.field, vo);
   return r;
 }
 
@@ -58,6 +62,16 @@ inline TetId tet_with_edge(const mesh::TetMesh& m, VertId a, VertId b) {
   mesh::collect_ball(m, a, ball);
   for (TetId t : ball)
     if (mesh::local_index(m, t, b) >= 0) return t;
+  return kNone;
+}
+
+/// A live tet with face (a, b, c), or kNone.
+inline TetId tet_with_face(const mesh::TetMesh& m, const std::array<VertId, 3>& f) {
+  if (m.vert2tet[f[0]] == kNone) return kNone;
+  std::vector<TetId> ball;
+  mesh::collect_ball(m, f[0], ball);
+  for (TetId t : ball)
+    if (mesh::local_index(m, t, f[1]) >= 0 && mesh::local_index(m, t, f[2]) >= 0) return t;
   return kNone;
 }
 

@@ -1,6 +1,7 @@
 // Property tests of the point operators: on meshes the project's volume
 // mesher makes of real models, thousands of random splits, collapses,
-// relocations and swaps — half of them aimed at the boundary surface — and
+// relocations, swaps and element deletions — half of them aimed at the
+// boundary surface — and
 // then every invariant checked from scratch (point_ops_support.hpp):
 // validity, adjacency, seeds, marks, classification and parameters on the
 // model, closed oriented region boundaries, region volumes on planar models.
@@ -12,6 +13,7 @@
 #include <random>
 
 #include "curvemesh/modify/collapse.hpp"
+#include "curvemesh/modify/delete_tet.hpp"
 #include "curvemesh/modify/marks.hpp"
 #include "curvemesh/modify/measure.hpp"
 #include "curvemesh/modify/relocate.hpp"
@@ -28,8 +30,8 @@ namespace {
 
 struct Counts {
   int splits = 0, boundary_splits = 0, collapses = 0, boundary_collapses = 0, moves = 0, boundary_moves = 0,
-      swaps = 0;
-  std::map<Refusal, int> split_refusals, collapse_refusals, move_refusals;
+      swaps = 0, deletions = 0, vertex_deletions = 0;
+  std::map<Refusal, int> split_refusals, collapse_refusals, move_refusals, deletion_refusals;
 };
 
 // Runs `steps` random operations; checks everything every `check_every`
@@ -74,8 +76,49 @@ Counts run_random(MeshedModel& r, int steps, unsigned seed, bool planar, int che
       ADD_FAILURE() << "boundary triangle edge (" << a << ", " << b << ") is no mesh edge";
       return n;
     }
-    const int kind = static_cast<int>(rng() % 4);
-    if (kind == 0) {
+    const int kind = static_cast<int>(rng() % 5);
+    if (kind == 4) {
+      // A tet against the boundary: the one holding a random triangle, or a
+      // neighbour of it (so that tets with two or three hull faces are hit).
+      if (m.tris.empty()) continue;
+      const auto tri = m.tris[rng() % m.tris.size()].verts;
+      TetId t = cm::test::tet_with_face(m, tri);
+      if (t == kNone) {
+        ADD_FAILURE() << "boundary triangle is no tet face";
+        return n;
+      }
+      if (rng() % 2) {
+        // Half the time a tet with two or more hull faces, if there is one
+        // (a scan: the meshes here are small).
+        std::vector<TetId> capped;
+        for (TetId u = 0; u < m.tet2verts.size(); ++u) {
+          if (ed.is_dead(u)) continue;
+          int hull = 0;
+          for (int f = 0; f < 4; ++f) hull += m.tet2adj[mesh::pack_face(u, f)] == kNone;
+          if (hull >= 2) capped.push_back(u);
+        }
+        if (!capped.empty()) t = capped[rng() % capped.size()];
+      } else {
+        const Index across = m.tet2adj[mesh::pack_face(t, static_cast<int>(rng() % 4))];
+        if (across != kNone) t = mesh::face_tet(across);
+      }
+      // The mesher's chord rule, or a loose one so that many deletions apply
+      // (and their invariants are checked) on coarse meshes of curved faces.
+      const auto plan = plan_tet_deletion(ed, cav, surf, t, model, DeletionOptions{rng() % 2 ? 0.04 : 0.3});
+      ++n.deletion_refusals[plan.refusal];
+      if (plan.refusal != Refusal::kNone) continue;
+      EXPECT_GT(plan.volume, 0);
+      const std::size_t tris_before = m.tris.size(), tets_before = ed.live_tets();
+      apply(ed, cav, surf, plan);
+      EXPECT_EQ(ed.live_tets(), tets_before - 1);
+      EXPECT_EQ(m.tris.size(), tris_before - static_cast<std::size_t>(plan.removed_count - plan.added_count));
+      if (plan.removed_vertex != kNone) {
+        EXPECT_EQ(m.vert2tet[plan.removed_vertex], kNone);
+        --live_verts;
+        ++n.vertex_deletions;
+      }
+      ++n.deletions;
+    } else if (kind == 0) {
       // Grow only while the mesh is not much bigger than at the start.
       if (live_verts > start_verts + start_verts / 4) continue;
       const auto plan = plan_split(ed, cav, surf, a, b, start, model);
@@ -122,7 +165,9 @@ Counts run_random(MeshedModel& r, int steps, unsigned seed, bool planar, int che
   return n;
 }
 
-void expect_busy(const Counts& n, int steps) {
+// `deletions`: how many element deletions must apply at least (none can on
+// planar faces: a tet with two faces on one plane would be flat).
+void expect_busy(const Counts& n, int steps, int deletions = 0) {
   // Tests that can fail: a good share of each operator must actually apply,
   // on the boundary too.
   EXPECT_GT(n.splits, steps / 40);
@@ -131,12 +176,15 @@ void expect_busy(const Counts& n, int steps) {
   EXPECT_GT(n.boundary_collapses, steps / 200);
   EXPECT_GT(n.moves, steps / 100);
   EXPECT_GT(n.boundary_moves, steps / 400);
+  EXPECT_GE(n.deletions, deletions);
   // The collapse's topological and classification rules do fire.
   EXPECT_GT(n.collapse_refusals.count(Refusal::kClassification) ? n.collapse_refusals.at(Refusal::kClassification) : 0, 0);
   EXPECT_GT(n.collapse_refusals.count(Refusal::kNonManifold) ? n.collapse_refusals.at(Refusal::kNonManifold) : 0, 0);
-  std::printf("splits %d (boundary %d), collapses %d (boundary %d), moves %d (boundary %d), swaps %d\n", n.splits,
-              n.boundary_splits, n.collapses, n.boundary_collapses, n.moves, n.boundary_moves, n.swaps);
-  for (const auto* map : {&n.split_refusals, &n.collapse_refusals, &n.move_refusals}) {
+  std::printf("splits %d (boundary %d), collapses %d (boundary %d), moves %d (boundary %d), swaps %d, deletions %d "
+              "(%d with their vertex)\n",
+              n.splits, n.boundary_splits, n.collapses, n.boundary_collapses, n.moves, n.boundary_moves, n.swaps,
+              n.deletions, n.vertex_deletions);
+  for (const auto* map : {&n.split_refusals, &n.collapse_refusals, &n.move_refusals, &n.deletion_refusals}) {
     std::printf(" ");
     for (const auto& [r, c] : *map) std::printf(" %s: %d;", std::string(to_string(r)).c_str(), c);
     std::printf("\n");
@@ -170,7 +218,7 @@ TEST(PointOpsRandom, SphereStaysOnTheModel) {
   // closest points with hints, folds checked against the model.
   auto r = cm::test::mesh_model("builtin:sphere", 0.35);
   const int steps = 20000;
-  expect_busy(run_random(r, steps, 3, false, 250), steps);
+  expect_busy(run_random(r, steps, 3, false, 250), steps, 5);
 }
 
 TEST(PointOpsRandom, CylinderStaysOnTheModel) {
@@ -178,14 +226,14 @@ TEST(PointOpsRandom, CylinderStaysOnTheModel) {
   // face at sharp edges.
   auto r = cm::test::mesh_model("builtin:cylinder", 0.3);
   const int steps = 20000;
-  expect_busy(run_random(r, steps, 4, false, 250), steps);
+  expect_busy(run_random(r, steps, 4, false, 250), steps, 5);
 }
 
 TEST(PointOpsRandom, TorusStaysOnTheModel) {
   // Periodic in u and v, concave and convex parts.
   auto r = cm::test::mesh_model("builtin:torus", 0.3);
   const int steps = 20000;
-  expect_busy(run_random(r, steps, 6, false, 500), steps);
+  expect_busy(run_random(r, steps, 6, false, 500), steps, 5);
 }
 
 TEST(PointOpsRandom, InclusionKeepsItsCurvedInterface) {
@@ -206,5 +254,5 @@ TEST(PointOpsRandom, SharedCadModel) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared models not found";
   auto r = cm::test::mesh_model(path, 0);
   const int steps = 10000;
-  expect_busy(run_random(r, steps, 5, false, 1000), steps);
+  expect_busy(run_random(r, steps, 5, false, 1000), steps, 5);
 }
