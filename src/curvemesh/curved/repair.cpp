@@ -13,6 +13,7 @@
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
 #include "curvemesh/modify/collapse.hpp"
+#include "curvemesh/modify/delete_tet.hpp"
 #include "curvemesh/modify/marks.hpp"
 #include "curvemesh/modify/relocate.hpp"
 #include "curvemesh/modify/split.hpp"
@@ -194,6 +195,7 @@ class Repairer {
   // --- steps ---------------------------------------------------------------
   void note_problem(TetId t, const ElementCheck& c);
   bool retriangulate(TetId t);
+  bool delete_element(TetId t);
   bool remesh(TetId t);
   bool reposition(TetId t);
   void curve_interior(TetId t);
@@ -387,7 +389,70 @@ bool Repairer::retriangulate(TetId t) {
   return true;
 }
 
-// --- step 2: remeshing -----------------------------------------------------------
+// --- step 2: element deletion ------------------------------------------------------
+
+// A tet with two or three faces on one model face (curved, det J vanishes
+// where its boundary edges meet tangent to the face) is taken out; the tets
+// around its new face edge get that edge curved on the face.
+bool Repairer::delete_element(TetId t) {
+  const modify::TetDeletion plan = modify::plan_tet_deletion(ed_, cav_, boundary_, t, &model_);
+  if (plan.refusal != modify::Refusal::kNone) return false;
+  // The new face edge: the one of the added triangles that is not on the
+  // boundary yet (none when a lone vertex goes with three faces).
+  VertId c = kNone, d = kNone;
+  for (int i = 0; i < plan.added_count && c == kNone; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const VertId x = plan.added[i][k], y = plan.added[i][(k + 1) % 3];
+      if (!m_.high_order.has_edge(x, y)) {
+        c = x;
+        d = y;
+        break;
+      }
+    }
+  std::vector<TetId> affected;
+  if (c != kNone) {
+    affected = mesh::collect_shell(m_, c, d, find_tet_with(c, d)).tets;
+  } else {
+    for (int f = 0; f < 4; ++f)
+      if (const Index across = m_.tet2adj[mesh::pack_face(t, f)]; across != kNone)
+        affected.push_back(mesh::face_tet(across));
+  }
+  const Outcome before = evaluate_tets(affected);
+  std::erase(affected, t);
+  Outcome after;
+  {
+    NodeOverride nodes(m_.high_order);
+    std::array<Vec3, mesh::kMaxOrder> buf;
+    if (c != kNone) {
+      placer_.edge_nodes(c, d, {2, plan.face_tag}, buf.data());
+      nodes.set_edge(c, d, std::span<const Vec3>(buf.data(), order_ - 1));
+    }
+    if (order_ >= 3)
+      for (int i = 0; i < plan.added_count; ++i) {
+        const auto& tri = plan.added[i];
+        std::array<std::array<Vec3, 2>, 3> e{};
+        for (int k = 0; k < 3; ++k) m_.high_order.get_edge(tri[k], tri[(k + 1) % 3], e[k].data());
+        Vec3 centre;
+        placer_.face_nodes(tri[0], tri[1], tri[2], plan.face_tag, e[0].data(), e[1].data(), e[2].data(), &centre);
+        nodes.set_face(tri[0], tri[1], tri[2], std::span<const Vec3>(&centre, 1));
+      }
+    after = evaluate_tets(affected);
+  }
+  if (!improves(after, before) && !(resolves(after) && before.bad > 0)) return false;
+  // Planned again: judging used the cavity's tets only, but be exact.
+  const modify::TetDeletion p = modify::plan_tet_deletion(ed_, cav_, boundary_, t, &model_);
+  const std::array<TetId, 1> gone{t};
+  before_edit(gone);
+  // The operator creates no tet: its hook call, empty, settles the deleted
+  // tet's entities (the new face edge gets its nodes, the old shared edge
+  // loses them); the tets around it are re-listed here.
+  modify::apply(ed_, cav_, boundary_, p);
+  created_.insert(created_.end(), affected.begin(), affected.end());
+  ++st_.deletions;
+  return true;
+}
+
+// --- step 3: remeshing -----------------------------------------------------------
 
 Outcome Repairer::judge_split(const modify::SplitPlan& plan, std::vector<TetId> shell) {
   const VertId a = plan.a, b = plan.b;
@@ -492,7 +557,12 @@ bool Repairer::remesh(TetId t) {
   std::vector<Candidate> candidates;
   for (const auto& e : mesh::kTetEdges) {
     const VertId a = tv[e[0]], b = tv[e[1]];
-    if (is_curved(a, b)) {
+    // Curved boundary edges, and interior edges: a tet that holds two
+    // boundary edges meeting at a vertex where they are tangent (model
+    // edges through a smooth model vertex, face edges of a flat corner) is
+    // singular there once curved, whatever its shape; the interior edge
+    // joining their far ends, split, leaves each new tet one of them.
+    if (is_curved(a, b) || !m_.high_order.has_edge(a, b)) {
       const modify::SplitPlan p = modify::plan_split(ed_, cav_, boundary_, a, b, t, &model_);
       if (p.refusal != modify::Refusal::kNone) continue;
       const std::vector<TetId> shell(cav_.tets().begin(), cav_.tets().end());
@@ -533,7 +603,7 @@ bool Repairer::remesh(TetId t) {
   return true;
 }
 
-// --- step 3: repositioning ---------------------------------------------------------
+// --- step 4: repositioning ---------------------------------------------------------
 
 bool Repairer::reposition(TetId t) {
   const Verts tv = m_.tet2verts[t];
@@ -591,7 +661,7 @@ bool Repairer::reposition(TetId t) {
   return false;
 }
 
-// --- step 4: curving interior edges ------------------------------------------------
+// --- step 5: curving interior edges ------------------------------------------------
 
 void Repairer::curve_interior(TetId t) {
   const Verts tv = m_.tet2verts[t];
@@ -644,7 +714,7 @@ void Repairer::curve_interior(TetId t) {
   }
 }
 
-// --- step 5: straightening ----------------------------------------------------------
+// --- step 6: straightening ----------------------------------------------------------
 
 void Repairer::straighten(std::vector<TetId> queue) {
   std::vector<TetId> ball;
@@ -699,7 +769,7 @@ RepairStats Repairer::run(std::span<const TetId> unacceptable) {
       const ElementCheck c = check(m_.tet2verts[t]);
       if (c.acceptable) continue;
       if (st_.passes == 0) note_problem(t, c);
-      if (retriangulate(t) || remesh(t) || reposition(t)) {
+      if (retriangulate(t) || delete_element(t) || remesh(t) || reposition(t)) {
         ++changes;
         ++ops;
       }

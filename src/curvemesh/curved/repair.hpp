@@ -10,10 +10,14 @@
 //    tet's interior edges (the shell's ring retriangulated by dynamic
 //    programming maximizing the worst curved quality) and the 2-3 swap of
 //    its interior faces;
-// 2. remeshing: split of its curved boundary edges (the new vertex on the
+// 2. element deletion with reclassification of interior entities onto the
+//    boundary (modify/delete_tet.hpp): a tet with two or three faces on one
+//    model face — curved, its boundary edges meet tangent to the face and
+//    det J vanishes there — is taken out of the domain;
+// 3. remeshing: split of its curved boundary edges (the new vertex on the
 //    model: the sagitta drops fourfold), collapse of its interior edges
 //    that have one end on the boundary onto that end;
-// 3. repositioning of its interior vertices, maximizing the worst curved
+// 4. repositioning of its interior vertices, maximizing the worst curved
 //    quality of their balls (pattern search).
 // An operation is taken when every tet it creates is acceptable, else the
 // best one that leaves fewer unacceptable tets (or as many, all better);
@@ -21,10 +25,10 @@
 // applied (modify's plans plus the nodes the new boundary entities would
 // get), and the list of unacceptable tets is updated after each step.
 // Then, for what remains:
-// 4. curving of interior edges of the tet (their nodes moved off the chord
+// 5. curving of interior edges of the tet (their nodes moved off the chord
 //    to maximize the worst quality of their shells) — reported, since the
 //    seed calls it undesirable;
-// 5. and, only if a tet is still not acceptable, straightening of its
+// 6. and, only if a tet is still not acceptable, straightening of its
 //    curved boundary entities (and of those of any tet this makes
 //    unacceptable): the straight-sided mesh is kept valid throughout (every
 //    operation checks the straight tets exactly), so this always ends with
@@ -44,10 +48,10 @@ namespace cm::curved {
 
 struct RepairOptions {
   Acceptance acceptance;
-  /// Passes of steps 1-3 over the tets still unacceptable.
+  /// Passes of steps 1-4 over the tets still unacceptable.
   int passes = 8;
-  bool interior_curving = true;  ///< step 4
-  bool straighten = true;        ///< step 5
+  bool interior_curving = true;  ///< step 5
+  bool straighten = true;        ///< step 6
 };
 
 struct RepairStats {
@@ -56,11 +60,11 @@ struct RepairStats {
   /// vertices), and one that comes too close to another entity of the tet
   /// (det J least on an entity that is not curved).
   std::size_t too_far = 0, too_close = 0;
-  std::size_t edge_removals = 0, face_swaps = 0, splits = 0, collapses = 0, relocations = 0;
-  /// Interior edges left curved at the end (step 4, less those step 5 took
+  std::size_t edge_removals = 0, face_swaps = 0, deletions = 0, splits = 0, collapses = 0, relocations = 0;
+  /// Interior edges left curved at the end (step 5, less those step 6 took
   /// back).
   std::size_t interior_edges_curved = 0;
-  /// Boundary edges and triangles left straight by step 5.
+  /// Boundary edges and triangles left straight by step 6.
   std::size_t edges_straightened = 0, faces_straightened = 0;
   int passes = 0;
   double seconds = 0;
@@ -73,7 +77,7 @@ struct RepairStats {
 /// place_boundary_nodes leaves them; adjacency is valid; the straight-sided
 /// mesh is valid; `model` is the mesh's model (its tags those of the
 /// classification). On return the mesh is compact (tets renumbered, unused
-/// vertices kept), adjacency valid, and with step 5 enabled every tet is
+/// vertices kept), adjacency valid, and with step 6 enabled every tet is
 /// certified valid and acceptable.
 RepairStats repair_curved_mesh(mesh::TetMesh& m, const geom::Model& model, std::span<const TetId> unacceptable,
                                const RepairOptions& options = {});

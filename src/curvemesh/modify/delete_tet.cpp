@@ -165,6 +165,8 @@ TetDeletion plan_tet_deletion(MeshEditor& ed, Cavity& cav, const BoundaryIndex& 
 }
 
 void apply(MeshEditor& ed, Cavity& cav, BoundaryIndex& surf, const TetDeletion& plan) {
+  // The hook runs once the new triangles are in m.tris.
+  const MeshEditor::DeferredHook defer(ed);
   // Removals from the highest index down: a removal moves the last entry
   // into the hole.
   std::array<Index, 3> old{};

@@ -106,11 +106,12 @@ std::vector<TetId> MeshEditor::compact() {
 }
 
 MeshEditor::DeferredHook::~DeferredHook() {
-  if (--ed_.deferrals_ > 0 || ed_.deferred_.empty()) return;
+  if (--ed_.deferrals_ > 0 || !ed_.deferred_pending_) return;
+  ed_.deferred_pending_ = false;
   std::vector<TetId> created;
   created.swap(ed_.deferred_);
   std::erase_if(created, [&](TetId t) { return ed_.is_dead(t); });
-  if (ed_.hook_ && !created.empty()) ed_.hook_(*ed_.m_, created);
+  if (ed_.hook_) ed_.hook_(*ed_.m_, created);
 }
 
 }  // namespace cm::modify

@@ -111,14 +111,16 @@ class MeshEditor {
   /// or, while a DeferredHook is alive, nothing yet (the tets are kept).
   void notify(std::span<const TetId> created) {
     if (!hook_) return;
-    if (deferrals_ > 0)
+    if (deferrals_ > 0) {
       deferred_.insert(deferred_.end(), created.begin(), created.end());
-    else
+      deferred_pending_ = true;
+    } else
       hook_(*m_, created);
   }
 
   /// Holds the hook back for the life of the object, then calls it once
-  /// with every tet created meanwhile that is still live. Operators that
+  /// (if a rebuild happened meanwhile) with every tet created meanwhile that
+  /// is still live, possibly none. Operators that
   /// edit m.tris / m.edges after their rebuild hold it, so the hook sees the
   /// finished edit (curving classifies the new entities by those arrays).
   class DeferredHook {
@@ -159,6 +161,7 @@ class MeshEditor {
   RebuildHook hook_;
   int deferrals_ = 0;
   std::vector<TetId> deferred_;
+  bool deferred_pending_ = false;
 };
 
 }  // namespace cm::modify
