@@ -794,8 +794,10 @@ RepairStats Repairer::run(std::span<const TetId> unacceptable) {
     // Curving an edge moves the nodes of its whole shell: a shell is taken
     // when it has fewer unacceptable tets, not only the ones listed, so the
     // list is made again.
-    ed_.compact();
-    bad = check_mesh(m_, o_.acceptance).unacceptable;
+    if (!interior_curved_.empty()) {
+      ed_.compact();
+      bad = check_mesh(m_, o_.acceptance).unacceptable;
+    }
   }
   if (o_.straighten) straighten(bad);
   // What is left of them: straightening takes back interior curving first.

@@ -17,11 +17,6 @@ std::vector<std::array<int, 3>> tri_interior_indices(int p) {
   return out;
 }
 
-std::uint64_t edge_key(VertId a, VertId b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(a) << 32) | b;
-}
-
 // Position, in the canonical interior list of a triangle sorted by vertex id,
 // of each interior node given relative to (a,b,c).
 std::vector<int> face_permutation(int p, const std::array<VertId, 3>& abc) {
@@ -37,6 +32,16 @@ std::vector<int> face_permutation(int p, const std::array<VertId, 3>& abc) {
     perm[n] = static_cast<int>(std::find(interior.begin(), interior.end(), sorted_index) - interior.begin());
   }
   return perm;
+}
+
+const std::vector<std::array<int, 3>>& cached_interior_indices(int p) {
+  static const std::array<std::vector<std::array<int, 3>>, kMaxOrder + 1> cache = [] {
+    std::array<std::vector<std::array<int, 3>>, kMaxOrder + 1> c;
+    for (int q = 1; q <= kMaxOrder; ++q) c[q] = tri_interior_indices(q);
+    return c;
+  }();
+  CM_ASSERT(p >= 1 && p <= kMaxOrder);
+  return cache[p];
 }
 
 const std::vector<std::array<int, 4>>& cached_tet_indices(int p) {
@@ -106,12 +111,90 @@ std::vector<std::array<int, 4>> tet_node_indices(int p) {
   return out;
 }
 
-std::size_t HighOrderNodes::FaceKeyHash::operator()(const FaceKey& k) const {
-  std::uint64_t h = k.v[0];
-  h = h * 0x9E3779B97F4A7C15ull ^ k.v[1];
-  h = h * 0x9E3779B97F4A7C15ull ^ k.v[2];
+// --- the slot table: open addressing on sorted vertex triples ---------------
+
+namespace {
+
+std::size_t hash_key(const std::array<VertId, 3>& k) {
+  std::uint64_t h = k[0];
+  h = h * 0x9E3779B97F4A7C15ull ^ k[1];
+  h = h * 0x9E3779B97F4A7C15ull ^ k[2];
   return static_cast<std::size_t>(h ^ (h >> 29));
 }
+
+std::array<VertId, 3> sorted_key(VertId a, VertId b, VertId c) {
+  if (a > b) std::swap(a, b);
+  if (b > c) std::swap(b, c);
+  if (a > b) std::swap(a, b);
+  return {a, b, c};
+}
+
+// An edge is the triple (a, b, kNone) with a < b.
+std::array<VertId, 3> edge_triple(VertId a, VertId b) {
+  if (a > b) std::swap(a, b);
+  return {a, b, kNone};
+}
+
+}  // namespace
+
+const std::uint32_t* HighOrderNodes::SlotTable::find(const std::array<VertId, 3>& key) const {
+  if (entries.empty()) return nullptr;
+  const std::size_t mask = entries.size() - 1;
+  for (std::size_t i = hash_key(key) & mask;; i = (i + 1) & mask) {
+    const Entry& e = entries[i];
+    if (e.slot == kEmpty) return nullptr;
+    if (e.key == key) return &e.slot;
+  }
+}
+
+std::pair<std::uint32_t*, bool> HighOrderNodes::SlotTable::insert(const std::array<VertId, 3>& key) {
+  if (2 * (size + 1) > entries.size()) grow();
+  const std::size_t mask = entries.size() - 1;
+  for (std::size_t i = hash_key(key) & mask;; i = (i + 1) & mask) {
+    Entry& e = entries[i];
+    if (e.slot == kEmpty) {
+      e.key = key;
+      ++size;
+      return {&e.slot, true};
+    }
+    if (e.key == key) return {&e.slot, false};
+  }
+}
+
+std::optional<std::uint32_t> HighOrderNodes::SlotTable::erase(const std::array<VertId, 3>& key) {
+  if (entries.empty()) return std::nullopt;
+  const std::size_t mask = entries.size() - 1;
+  std::size_t i = hash_key(key) & mask;
+  while (entries[i].slot != kEmpty && entries[i].key != key) i = (i + 1) & mask;
+  if (entries[i].slot == kEmpty) return std::nullopt;
+  const std::uint32_t slot = entries[i].slot;
+  // Backward-shift deletion: no tombstones build up over many erases.
+  for (std::size_t j = (i + 1) & mask; entries[j].slot != kEmpty; j = (j + 1) & mask) {
+    const std::size_t home = hash_key(entries[j].key) & mask;
+    if (((j - home) & mask) >= ((j - i) & mask)) {
+      entries[i] = entries[j];
+      i = j;
+    }
+  }
+  entries[i].slot = kEmpty;
+  --size;
+  return slot;
+}
+
+void HighOrderNodes::SlotTable::grow() {
+  std::vector<Entry> old = std::move(entries);
+  entries.assign(std::max<std::size_t>(16, 2 * old.size()), Entry{});
+  size = 0;
+  for (const Entry& e : old)
+    if (e.slot != kEmpty) *insert(e.key).first = e.slot;
+}
+
+void HighOrderNodes::SlotTable::clear() {
+  entries.clear();
+  size = 0;
+}
+
+// --- HighOrderNodes ------------------------------------------------------------
 
 void HighOrderNodes::reset(int order) {
   if (order < 1 || order > kMaxOrder)
@@ -125,30 +208,33 @@ void HighOrderNodes::reset(int order) {
   free_face_slots_.clear();
 }
 
+std::uint32_t HighOrderNodes::take_slot(std::vector<std::uint32_t>& free, std::vector<Vec3>& nodes, std::size_t n) {
+  if (!free.empty()) {
+    const std::uint32_t s = free.back();
+    free.pop_back();
+    return s;
+  }
+  const auto s = static_cast<std::uint32_t>(nodes.size() / n);
+  nodes.resize(nodes.size() + n);
+  return s;
+}
+
 void HighOrderNodes::set_edge(VertId a, VertId b, std::span<const Vec3> nodes_from_a) {
   const std::size_t n = nodes_per_edge();
   CM_ASSERT_OP(nodes_from_a.size(), ==, n);
   if (n == 0) return;
-  auto [it, inserted] = edge_slot_.try_emplace(edge_key(a, b), 0u);
-  if (inserted) {
-    if (!free_edge_slots_.empty()) {
-      it->second = free_edge_slots_.back();
-      free_edge_slots_.pop_back();
-    } else {
-      it->second = static_cast<std::uint32_t>(edge_nodes_.size() / n);
-      edge_nodes_.resize(edge_nodes_.size() + n);
-    }
-  }
-  Vec3* dst = edge_nodes_.data() + it->second * n;
+  const auto [slot, inserted] = edge_slot_.insert(edge_triple(a, b));
+  if (inserted) *slot = take_slot(free_edge_slots_, edge_nodes_, n);
+  Vec3* dst = edge_nodes_.data() + std::size_t{*slot} * n;
   for (std::size_t s = 0; s < n; ++s) dst[a < b ? s : n - 1 - s] = nodes_from_a[s];
 }
 
 bool HighOrderNodes::get_edge(VertId a, VertId b, Vec3* out_from_a) const {
   const std::size_t n = nodes_per_edge();
   if (n == 0) return false;
-  auto it = edge_slot_.find(edge_key(a, b));
-  if (it == edge_slot_.end()) return false;
-  const Vec3* src = edge_nodes_.data() + it->second * n;
+  const std::uint32_t* slot = edge_slot_.find(edge_triple(a, b));
+  if (!slot) return false;
+  const Vec3* src = edge_nodes_.data() + std::size_t{*slot} * n;
   for (std::size_t s = 0; s < n; ++s) out_from_a[s] = src[a < b ? s : n - 1 - s];
   return true;
 }
@@ -157,84 +243,71 @@ void HighOrderNodes::set_face(VertId a, VertId b, VertId c, std::span<const Vec3
   const std::size_t n = nodes_per_face();
   CM_ASSERT_OP(nodes.size(), ==, n);
   if (n == 0) return;
-  std::array<VertId, 3> s{a, b, c};
-  std::sort(s.begin(), s.end());
-  auto [it, inserted] = face_slot_.try_emplace(FaceKey{{s[0], s[1], s[2]}}, 0u);
-  if (inserted) {
-    if (!free_face_slots_.empty()) {
-      it->second = free_face_slots_.back();
-      free_face_slots_.pop_back();
-    } else {
-      it->second = static_cast<std::uint32_t>(face_nodes_.size() / n);
-      face_nodes_.resize(face_nodes_.size() + n);
-    }
+  const auto [slot, inserted] = face_slot_.insert(sorted_key(a, b, c));
+  if (inserted) *slot = take_slot(free_face_slots_, face_nodes_, n);
+  Vec3* dst = face_nodes_.data() + std::size_t{*slot} * n;
+  if (n == 1) {
+    dst[0] = nodes[0];
+    return;
   }
-  Vec3* dst = face_nodes_.data() + it->second * n;
   const auto perm = face_permutation(order_, {a, b, c});
   for (std::size_t k = 0; k < n; ++k) dst[perm[k]] = nodes[k];
-}
-
-void HighOrderNodes::remap_vertices(std::span<const VertId> old2new) {
-  // Order-preserving renaming keeps each key's sorted order, so the stored
-  // node order (relative to the sorted vertices) stays right.
-  std::unordered_map<std::uint64_t, std::uint32_t> edges;
-  for (const auto& [key, slot] : edge_slot_) {
-    const VertId a = old2new[key >> 32], b = old2new[key & 0xffffffffu];
-    if (a == kNone || b == kNone)
-      free_edge_slots_.push_back(slot);
-    else
-      edges.emplace(edge_key(a, b), slot);
-  }
-  edge_slot_ = std::move(edges);
-  std::unordered_map<FaceKey, std::uint32_t, FaceKeyHash> faces;
-  for (const auto& [key, slot] : face_slot_) {
-    const VertId a = old2new[key.v[0]], b = old2new[key.v[1]], c = old2new[key.v[2]];
-    if (a == kNone || b == kNone || c == kNone)
-      free_face_slots_.push_back(slot);
-    else
-      faces.emplace(FaceKey{{a, b, c}}, slot);
-  }
-  face_slot_ = std::move(faces);
-}
-
-bool HighOrderNodes::has_edge(VertId a, VertId b) const {
-  return nodes_per_edge() > 0 && edge_slot_.count(edge_key(a, b)) > 0;
-}
-
-bool HighOrderNodes::has_face(VertId a, VertId b, VertId c) const {
-  if (nodes_per_face() == 0) return false;
-  std::array<VertId, 3> s{a, b, c};
-  std::sort(s.begin(), s.end());
-  return face_slot_.count(FaceKey{{s[0], s[1], s[2]}}) > 0;
-}
-
-void HighOrderNodes::erase_edge(VertId a, VertId b) {
-  const auto it = edge_slot_.find(edge_key(a, b));
-  if (it == edge_slot_.end()) return;
-  free_edge_slots_.push_back(it->second);
-  edge_slot_.erase(it);
-}
-
-void HighOrderNodes::erase_face(VertId a, VertId b, VertId c) {
-  std::array<VertId, 3> s{a, b, c};
-  std::sort(s.begin(), s.end());
-  const auto it = face_slot_.find(FaceKey{{s[0], s[1], s[2]}});
-  if (it == face_slot_.end()) return;
-  free_face_slots_.push_back(it->second);
-  face_slot_.erase(it);
 }
 
 bool HighOrderNodes::get_face(VertId a, VertId b, VertId c, Vec3* out) const {
   const std::size_t n = nodes_per_face();
   if (n == 0) return false;
-  std::array<VertId, 3> s{a, b, c};
-  std::sort(s.begin(), s.end());
-  auto it = face_slot_.find(FaceKey{{s[0], s[1], s[2]}});
-  if (it == face_slot_.end()) return false;
-  const Vec3* src = face_nodes_.data() + it->second * n;
+  const std::uint32_t* slot = face_slot_.find(sorted_key(a, b, c));
+  if (!slot) return false;
+  const Vec3* src = face_nodes_.data() + std::size_t{*slot} * n;
+  if (n == 1) {
+    out[0] = src[0];
+    return true;
+  }
   const auto perm = face_permutation(order_, {a, b, c});
   for (std::size_t k = 0; k < n; ++k) out[k] = src[perm[k]];
   return true;
+}
+
+void HighOrderNodes::remap_vertices(std::span<const VertId> old2new) {
+  // Order-preserving renaming keeps each key's sorted order, so the stored
+  // node order (relative to the sorted vertices) stays right.
+  auto remap = [&](SlotTable& table, std::vector<std::uint32_t>& free) {
+    SlotTable renamed;
+    for (const SlotTable::Entry& e : table.entries) {
+      if (e.slot == SlotTable::kEmpty) continue;
+      std::array<VertId, 3> k = e.key;
+      bool dropped = false;
+      for (VertId& v : k)
+        if (v != kNone) {
+          v = old2new[v];
+          dropped |= v == kNone;
+        }
+      if (dropped)
+        free.push_back(e.slot);
+      else
+        *renamed.insert(k).first = e.slot;
+    }
+    table = std::move(renamed);
+  };
+  remap(edge_slot_, free_edge_slots_);
+  remap(face_slot_, free_face_slots_);
+}
+
+bool HighOrderNodes::has_edge(VertId a, VertId b) const {
+  return nodes_per_edge() > 0 && edge_slot_.find(edge_triple(a, b)) != nullptr;
+}
+
+bool HighOrderNodes::has_face(VertId a, VertId b, VertId c) const {
+  return nodes_per_face() > 0 && face_slot_.find(sorted_key(a, b, c)) != nullptr;
+}
+
+void HighOrderNodes::erase_edge(VertId a, VertId b) {
+  if (const auto slot = edge_slot_.erase(edge_triple(a, b))) free_edge_slots_.push_back(*slot);
+}
+
+void HighOrderNodes::erase_face(VertId a, VertId b, VertId c) {
+  if (const auto slot = face_slot_.erase(sorted_key(a, b, c))) free_face_slots_.push_back(*slot);
 }
 
 namespace {
@@ -245,7 +318,7 @@ std::vector<Vec3> gather_nodes(const TetMesh& m, const std::array<VertId, K>& v,
                                const std::vector<std::array<int, K>>& indices) {
   const int p = m.high_order.order();
   std::vector<Vec3> out(indices.size());
-  std::vector<Vec3> buf(static_cast<std::size_t>(p * p));
+  std::array<Vec3, kMaxOrder * kMaxOrder> buf;
   for (std::size_t n = 0; n < indices.size(); ++n) {
     const auto& idx = indices[n];
     int nz[K];
@@ -263,7 +336,7 @@ std::vector<Vec3> gather_nodes(const TetMesh& m, const std::array<VertId, K>& v,
       if (m.high_order.get_edge(v[nz[0]], v[nz[1]], buf.data())) out[n] = buf[idx[nz[1]] - 1];
     } else if (count == 3) {
       if (m.high_order.get_face(v[nz[0]], v[nz[1]], v[nz[2]], buf.data())) {
-        const auto interior = tri_interior_indices(p);
+        const auto& interior = cached_interior_indices(p);
         const std::array<int, 3> rel{idx[nz[0]], idx[nz[1]], idx[nz[2]]};
         out[n] = buf[std::find(interior.begin(), interior.end(), rel) - interior.begin()];
       }

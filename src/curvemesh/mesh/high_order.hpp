@@ -4,7 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
-#include <unordered_map>
+#include <optional>
 #include <vector>
 
 #include "curvemesh/core/types.hpp"
@@ -57,33 +57,39 @@ class HighOrderNodes {
   /// compaction does); entries on a vertex mapped to kNone are dropped.
   void remap_vertices(std::span<const VertId> old2new);
 
-  std::size_t num_edges() const { return edge_slot_.size(); }
-  std::size_t num_faces() const { return face_slot_.size(); }
+  std::size_t num_edges() const { return edge_slot_.size; }
+  std::size_t num_faces() const { return face_slot_.size; }
   std::size_t nodes_per_edge() const { return order_ > 1 ? order_ - 1 : 0; }
   std::size_t nodes_per_face() const {
     return order_ > 2 ? static_cast<std::size_t>((order_ - 1) * (order_ - 2) / 2) : 0;
   }
 
-  /// Calls fn(a, b, nodes_from_a) for every stored edge (a < b).
-  template <class Fn>
-  void for_each_edge(Fn&& fn) const {
-    for (const auto& [key, slot] : edge_slot_)
-      fn(static_cast<VertId>(key >> 32), static_cast<VertId>(key & 0xffffffffu),
-         std::span<const Vec3>(edge_nodes_.data() + slot * nodes_per_edge(), nodes_per_edge()));
-  }
-
  private:
-  struct FaceKey {
-    VertId v[3];
-    friend bool operator==(const FaceKey&, const FaceKey&) = default;
+  // Where each entity's nodes are: open addressing on sorted vertex
+  // triples (an edge is (a, b, kNone)), backward-shift erasure. Every tet
+  // check looks up six edges and four faces, so the table is flat.
+  struct SlotTable {
+    static constexpr std::uint32_t kEmpty = 0xffffffffu;
+    struct Entry {
+      std::array<VertId, 3> key{kNone, kNone, kNone};
+      std::uint32_t slot = kEmpty;
+    };
+    std::vector<Entry> entries;  // size a power of two, at most half full
+    std::size_t size = 0;
+    const std::uint32_t* find(const std::array<VertId, 3>& key) const;
+    /// The slot of key (inserted with an unset slot if absent), and
+    /// whether it was inserted.
+    std::pair<std::uint32_t*, bool> insert(const std::array<VertId, 3>& key);
+    std::optional<std::uint32_t> erase(const std::array<VertId, 3>& key);
+    void grow();
+    void clear();
   };
-  struct FaceKeyHash {
-    std::size_t operator()(const FaceKey& k) const;
-  };
+  static std::uint32_t take_slot(std::vector<std::uint32_t>& free, std::vector<Vec3>& nodes, std::size_t n);
+
   int order_ = 1;
-  std::unordered_map<std::uint64_t, std::uint32_t> edge_slot_;
+  SlotTable edge_slot_;
   std::vector<Vec3> edge_nodes_;
-  std::unordered_map<FaceKey, std::uint32_t, FaceKeyHash> face_slot_;
+  SlotTable face_slot_;
   std::vector<Vec3> face_nodes_;
   // Slots of erased entries, reused first: curving repairs erase and set
   // nodes many times over.
