@@ -35,6 +35,14 @@ void add_curving_flags(CLI::App* cmd, CurvingFlags& flags, int default_order) {
 
 nlohmann::json curve_report_json(const curved::CurveReport& r) {
   const curved::RepairStats& s = r.repair;
+  // Vertex ids are those of the mesh before the repair (it may renumber).
+  nlohmann::json listed = nlohmann::json::array();
+  for (const curved::ProblemEntities& p : s.problems)
+    listed.push_back({{"tet_vertices", p.tet},
+                      {"score", p.score},
+                      {"least_det_j_at", p.at},
+                      {"curved_edges", p.curved_edges},
+                      {"case", p.too_far ? "too far from straight" : "too close"}});
   return {{"order", r.order},
           {"nodes", {{"edges_on_model_edges", r.placement.edges_on_model_edges},
                      {"edges_on_model_faces", r.placement.edges_on_model_faces},
@@ -50,7 +58,7 @@ nlohmann::json curve_report_json(const curved::CurveReport& r) {
                      {"mean_scaled_jacobian", r.after.mean_scaled_jacobian},
                      {"min_measure", r.after.min_measure},
                      {"mean_measure", r.after.mean_measure}}},
-          {"problems", {{"too_far_from_straight", s.too_far}, {"too_close", s.too_close}}},
+          {"problems", {{"too_far_from_straight", s.too_far}, {"too_close", s.too_close}, {"listed", listed}}},
           {"operations", {{"edge_removals", s.edge_removals},
                           {"face_swaps", s.face_swaps},
                           {"deletions", s.deletions},

@@ -330,20 +330,28 @@ void Repairer::after_edit(std::span<const TetId> created) {
 
 void Repairer::note_problem(TetId t, const ElementCheck& c) {
   const auto& v = m_.tet2verts[t];
-  bool on_curved = false;
-  if (c.where.dim == 1) {
-    const auto& e = mesh::kTetEdges[c.where.index];
-    on_curved = is_curved(v[e[0]], v[e[1]]);
-  } else if (c.where.dim == 2 || c.where.dim == 0) {
-    // det J least on a face or at a vertex of curved edges: the curved
-    // entities there bend their tet out of shape themselves.
-    for (const auto& e : mesh::kTetEdges) {
-      const bool touches = c.where.dim == 0 ? (e[0] == c.where.index || e[1] == c.where.index)
-                                            : (e[0] != c.where.index && e[1] != c.where.index);
-      if (touches && is_curved(v[e[0]], v[e[1]])) on_curved = true;
-    }
+  ProblemEntities p;
+  p.tet = v;
+  p.score = c.score();
+  // The mesh entity where det J is least.
+  switch (c.where.dim) {
+    case 0: p.at = {v[c.where.index]}; break;
+    case 1: p.at = {v[mesh::kTetEdges[c.where.index][0]], v[mesh::kTetEdges[c.where.index][1]]}; break;
+    case 2:
+      for (int k : mesh::kFaceVerts[c.where.index]) p.at.push_back(v[k]);
+      break;
+    default: p.at.assign(v.begin(), v.end());
   }
-  ++(on_curved ? st_.too_far : st_.too_close);
+  for (const auto& e : mesh::kTetEdges)
+    if (is_curved(v[e[0]], v[e[1]])) p.curved_edges.push_back({v[e[0]], v[e[1]]});
+  // Least on a curved entity or at its ends (the seed's Fig. 3.1 e, f: a
+  // curved entity too far from its straight element), else on an entity
+  // that is not curved, which a curved one approaches (Fig. 3.1 a-d).
+  const auto on = [&](VertId x) { return std::find(p.at.begin(), p.at.end(), x) != p.at.end(); };
+  for (const auto& e : p.curved_edges)
+    if (c.where.dim < 3 && (c.where.dim == 0 ? (on(e[0]) || on(e[1])) : (on(e[0]) && on(e[1])))) p.too_far = true;
+  ++(p.too_far ? st_.too_far : st_.too_close);
+  if (st_.problems.size() < RepairStats::kMaxListed) st_.problems.push_back(std::move(p));
 }
 
 // --- step 1: retriangulation -----------------------------------------------------

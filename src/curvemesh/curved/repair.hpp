@@ -37,8 +37,10 @@
 // parameters, boundary triangles and adjacency stay right; the nodes of
 // the boundary entities it creates are placed on the model by the editor's
 // rebuild hook.
+#include <array>
 #include <cstddef>
 #include <span>
+#include <vector>
 
 #include "curvemesh/curved/element_check.hpp"
 #include "curvemesh/geom/model.hpp"
@@ -54,12 +56,28 @@ struct RepairOptions {
   bool straighten = true;        ///< step 6
 };
 
+/// The entities to modify in one unacceptable tet, as the repair found them.
+struct ProblemEntities {
+  std::array<VertId, 4> tet{};
+  double score = 0;  ///< ElementCheck::score() when found
+  /// The mesh entity (1 to 4 vertices) where det J is least.
+  std::vector<VertId> at;
+  /// The tet's curved edges.
+  std::vector<std::array<VertId, 2>> curved_edges;
+  /// det J least on a curved entity or at its ends (it strays too far from
+  /// the straight element), rather than on an entity it comes too close to.
+  bool too_far = false;
+};
+
 struct RepairStats {
   /// Problem entities found, by the seed's cases: a curved boundary entity
   /// that strays too far from its straight tet (det J least on it or at its
   /// vertices), and one that comes too close to another entity of the tet
   /// (det J least on an entity that is not curved).
   std::size_t too_far = 0, too_close = 0;
+  /// The first kMaxListed of them, worst first within each pass.
+  static constexpr std::size_t kMaxListed = 100;
+  std::vector<ProblemEntities> problems;
   std::size_t edge_removals = 0, face_swaps = 0, deletions = 0, splits = 0, collapses = 0, relocations = 0;
   /// Interior edges left curved at the end (step 5, less those step 6 took
   /// back).
