@@ -61,6 +61,7 @@ nlohmann::json curve_report_json(const curved::CurveReport& r) {
           {"problems", {{"too_far_from_straight", s.too_far}, {"too_close", s.too_close}, {"listed", listed}}},
           {"operations", {{"edge_removals", s.edge_removals},
                           {"face_swaps", s.face_swaps},
+                          {"boundary_swaps", s.boundary_swaps},
                           {"deletions", s.deletions},
                           {"splits", s.splits},
                           {"collapses", s.collapses},
@@ -89,10 +90,10 @@ void print_curve_report(const curved::CurveReport& r) {
              r.invalid_before, r.unacceptable_before, r.min_scaled_jacobian_before, r.min_measure_before);
   if (r.unacceptable_before > 0)
     fmt::print("  problems: {} curved entities too far from the straight element, {} too close to another; "
-               "repair: {} edge removals, {} face swaps, {} deletions, {} splits, {} collapses, {} relocations, {} "
-               "interior edges curved, {} boundary edges straightened, in {} passes\n",
-               s.too_far, s.too_close, s.edge_removals, s.face_swaps, s.deletions, s.splits, s.collapses,
-               s.relocations, s.interior_edges_curved, s.edges_straightened, s.passes);
+               "repair: {} edge removals, {} face swaps, {} boundary swaps, {} deletions, {} splits, {} collapses, {} "
+               "relocations, {} interior edges curved, {} boundary edges straightened, in {} passes\n",
+               s.too_far, s.too_close, s.edge_removals, s.face_swaps, s.boundary_swaps, s.deletions, s.splits,
+               s.collapses, s.relocations, s.interior_edges_curved, s.edges_straightened, s.passes);
   fmt::print("  after: {} certified invalid, {} unacceptable; scaled Jacobian min {:.4f} mean {:.4f}; I min {:.4f} "
              "mean {:.4f}\n",
              r.after.invalid.size(), r.after.unacceptable.size(), r.after.min_scaled_jacobian,

@@ -12,6 +12,7 @@
 #include "curvemesh/curved/nodes.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
+#include "curvemesh/modify/boundary_swap.hpp"
 #include "curvemesh/modify/collapse.hpp"
 #include "curvemesh/modify/delete_tet.hpp"
 #include "curvemesh/modify/marks.hpp"
@@ -204,7 +205,11 @@ class Repairer {
   // Candidate judging of the point operators: the tets they would create,
   // with the nodes their new boundary entities would get.
   Outcome judge_split(const modify::SplitPlan& plan, std::vector<TetId> shell);
+  // The boundary swap of face edge (a, b); bad = -1 when refused. Leaves the
+  // cavity holding the edge's shell.
+  Outcome judge_boundary_swap(VertId a, VertId b, TetId t);
   Outcome judge_collapse(const modify::CollapsePlan& plan, std::vector<TetId> ball);
+  bool keeps_chord_rule(VertId from, VertId to, std::span<const TetId> ball) const;
 
   mesh::TetMesh& m_;
   const geom::Model& model_;
@@ -389,12 +394,66 @@ bool Repairer::retriangulate(TetId t) {
         best_local = local;
       }
     }
+  // The boundary's own retriangulation: a curved face edge of the tet
+  // swapped on its model face (the quad's other diagonal, the open shell
+  // retriangulated). What fixes a boundary triangle whose corner is near
+  // 180°, where two model edges tangent at a model vertex meet: curved, its
+  // edges there line up and det J vanishes.
+  int best_swap_edge = -1;
+  for (int local = 0; local < 6; ++local) {
+    const auto& e = mesh::kTetEdges[local];
+    const VertId a = tv[e[0]], b = tv[e[1]];
+    if (!is_curved(a, b)) continue;
+    const Outcome candidate = judge_boundary_swap(a, b, t);
+    if (candidate.bad < 0) continue;
+    const Outcome before = evaluate_tets(cav_.tets());
+    if (!improves(candidate, before) && !(resolves(candidate) && before.bad > 0)) continue;
+    if ((best_kind < 0 && best_swap_edge < 0) || ranks_above(candidate, best)) {
+      best = candidate;
+      best_swap_edge = local;
+    }
+  }
+  if (best_swap_edge >= 0) {
+    const auto& e = mesh::kTetEdges[best_swap_edge];
+    const modify::BoundarySwap p =
+        modify::plan_boundary_edge_swap(ed_, cav_, boundary_, tv[e[0]], tv[e[1]], t, &model_);
+    before_edit(cav_.tets());
+    modify::apply(ed_, cav_, boundary_, p);
+    ++st_.boundary_swaps;
+    return true;
+  }
   if (best_kind < 0) return false;
   const modify::Plan p = plan(best_kind, best_local);
   before_edit(cav_.tets());
   modify::apply(ed_, cav_, p);
   ++(best_kind == 0 ? st_.edge_removals : st_.face_swaps);
   return true;
+}
+
+Outcome Repairer::judge_boundary_swap(VertId a, VertId b, TetId t) {
+  Outcome none;
+  none.bad = -1;
+  // First for the new edge's ends, then judged with it curved on the face.
+  const modify::BoundarySwap first = modify::plan_boundary_edge_swap(ed_, cav_, boundary_, a, b, t, &model_);
+  if (first.refusal != modify::Refusal::kNone && first.refusal != modify::Refusal::kNoImprovement) return none;
+  NodeOverride nodes(m_.high_order);
+  std::array<Vec3, mesh::kMaxOrder> buf;
+  placer_.edge_nodes(first.c, first.d, {2, first.face_tag}, buf.data());
+  nodes.set_edge(first.c, first.d, std::span<const Vec3>(buf.data(), order_ - 1));
+  if (order_ >= 3)
+    for (const auto& tri : first.added) {
+      std::array<std::array<Vec3, 2>, 3> e{};
+      for (int k = 0; k < 3; ++k) m_.high_order.get_edge(tri[k], tri[(k + 1) % 3], e[k].data());
+      Vec3 centre;
+      placer_.face_nodes(tri[0], tri[1], tri[2], first.face_tag, e[0].data(), e[1].data(), e[2].data(), &centre);
+      nodes.set_face(tri[0], tri[1], tri[2], std::span<const Vec3>(&centre, 1));
+    }
+  const modify::BoundarySwap p =
+      modify::plan_boundary_edge_swap(ed_, cav_, boundary_, a, b, t, &model_, &Repairer::curved_measure, this);
+  if (p.refusal != modify::Refusal::kNone && p.refusal != modify::Refusal::kNoImprovement) return none;
+  std::vector<Verts> fill;
+  for (const auto& nt : p.fill) fill.push_back(nt.verts);
+  return evaluate(fill);
 }
 
 // --- step 2: element deletion ------------------------------------------------------
@@ -511,8 +570,45 @@ Outcome Repairer::judge_split(const modify::SplitPlan& plan, std::vector<TetId> 
   return evaluate(fill);
 }
 
+bool Repairer::keeps_chord_rule(VertId from, VertId to, std::span<const TetId> ball) const {
+  // The triangles through `from` that survive, moved to `to`: their
+  // centroids may not stray from the face more than the mesher's curvature
+  // rule allows (alpha times the longest edge), unless no farther than the
+  // triangles they come from. Collapsing boundary vertices coarsens the
+  // surface, and the straight elements' geometric error with it.
+  constexpr double kAlpha = 0.04;
+  for (TetId s : ball) {
+    const auto& tv = m_.tet2verts[s];
+    for (const auto& f : mesh::kFaceVerts) {
+      const std::array<VertId, 3> tri{tv[f[0]], tv[f[1]], tv[f[2]]};
+      if (std::find(tri.begin(), tri.end(), from) == tri.end() || std::find(tri.begin(), tri.end(), to) != tri.end())
+        continue;
+      const Index i = boundary_.find_tri(tri[0], tri[1], tri[2]);
+      if (i == kNone) continue;
+      const int face = m_.tris[i].face_tag;
+      std::array<VertId, 3> moved = tri;
+      for (VertId& x : moved)
+        if (x == from) x = to;
+      auto deviation = [&](const std::array<VertId, 3>& v) {
+        const Vec3 c = (m_.coords[v[0]] + m_.coords[v[1]] + m_.coords[v[2]]) / 3;
+        return model_.closest_point({2, face}, c, modify::check_hint(m_, v, face)).distance;
+      };
+      double longest = 0;
+      for (int k = 0; k < 3; ++k) longest = std::max(longest, (m_.coords[moved[k]] - m_.coords[moved[(k + 1) % 3]]).norm());
+      const double after = deviation(moved);
+      if (after > kAlpha * longest && after > deviation(tri)) return false;
+    }
+  }
+  return true;
+}
+
 Outcome Repairer::judge_collapse(const modify::CollapsePlan& plan, std::vector<TetId> ball) {
   const VertId from = plan.from, to = plan.to;
+  if (m_.vert_class[from].dim < 3 && !keeps_chord_rule(from, to, ball)) {
+    Outcome refused;
+    refused.straight_ok = false;
+    return refused;
+  }
   NodeOverride nodes(m_.high_order);
   std::array<Vec3, mesh::kMaxOrder> buf;
   const std::span<const Vec3> out(buf.data(), order_ - 1);
@@ -579,10 +675,13 @@ bool Repairer::remesh(TetId t) {
       if (improves(after, before) || (resolves(after) && before.bad > 0)) candidates.push_back({kSplit, a, b, after});
     }
     // An interior edge with one end on the boundary: its inner end goes onto
-    // the boundary end (seed Fig. 3.7).
+    // the boundary end (seed Fig. 3.7). And a boundary vertex along its own
+    // model entity (the collapse's classification rules decide which): what
+    // removes a boundary triangle with a corner near 180°, which no swap
+    // can reach, by taking out its vertex next to the corner.
     for (int side = 0; side < 2; ++side) {
       const VertId from = side ? b : a, to = side ? a : b;
-      if (m_.vert_class[from].dim != 3 || m_.vert_class[to].dim == 3) continue;
+      if (m_.vert_class[from].dim == 3 && m_.vert_class[to].dim == 3) continue;
       const modify::CollapsePlan p = modify::plan_collapse(ed_, cav_, boundary_, from, to, &model_);
       if (p.refusal != modify::Refusal::kNone) continue;
       const std::vector<TetId> ball(cav_.tets().begin(), cav_.tets().end());

@@ -8,8 +8,9 @@
 // applied:
 // 1. retriangulation, which moves and adds no vertex: edge removal of the
 //    tet's interior edges (the shell's ring retriangulated by dynamic
-//    programming maximizing the worst curved quality) and the 2-3 swap of
-//    its interior faces;
+//    programming maximizing the worst curved quality), the 2-3 swap of its
+//    interior faces, and the swap of its curved face edges on their model
+//    face (modify/boundary_swap.hpp);
 // 2. element deletion with reclassification of interior entities onto the
 //    boundary (modify/delete_tet.hpp): a tet with two or three faces on one
 //    model face — curved, its boundary edges meet tangent to the face and
@@ -78,7 +79,8 @@ struct RepairStats {
   /// The first kMaxListed of them, worst first within each pass.
   static constexpr std::size_t kMaxListed = 100;
   std::vector<ProblemEntities> problems;
-  std::size_t edge_removals = 0, face_swaps = 0, deletions = 0, splits = 0, collapses = 0, relocations = 0;
+  std::size_t edge_removals = 0, face_swaps = 0, boundary_swaps = 0, deletions = 0, splits = 0, collapses = 0,
+              relocations = 0;
   /// Interior edges left curved at the end (step 5, less those step 6 took
   /// back).
   std::size_t interior_edges_curved = 0;
