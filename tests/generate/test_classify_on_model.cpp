@@ -1,8 +1,8 @@
 // classify_on_model: exact counts on a structured box, curvemesh's own meshes
 // of the builtins (with their tags scrambled, merged and split) and of a
 // shared model through MSH given back exactly as written, Gmsh's meshes of
-// every shared model (orders 1 and 2) passing the boundary check, and meshes
-// of another model.
+// every shared model (orders 1 and 2) passing the boundary check, the
+// optimize command on a Gmsh mesh with --model, and meshes of another model.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -440,4 +440,33 @@ TEST(ClassifyOnModel, GmshMeshOfAnotherShapeIsOneClearError) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   mesh::TetMesh m = io::read_mesh(dir + "/t20.msh");
   EXPECT_THROW(generate::classify_on_model(m, *model, {dir + "/t20.msh"}), InputError);
+}
+
+// --- the optimize command ------------------------------------------------------
+
+TEST(ClassifyOnModel, OptimizeGmshMeshWithModel) {
+  if (!have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
+  const std::string file = models_dir() + "/Zylkopf.stp";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "no shared model " << file;
+  const std::string dir = test::make_temp_dir("classify_optimize");
+  auto r = test::run_command(fmt::format(
+      "{} -3 -nt 1 -setnumber Mesh.Optimize 0 -setnumber Mesh.MeshSizeFromCurvature 12 -setnumber Mesh.MeshSizeMax 2 "
+      "'{}' -o '{}/in.msh' -format msh41",
+      CM_GMSH_EXECUTABLE, file, dir));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_cli(fmt::format("optimize {0}/in.msh --model '{1}' -o {0}/out.msh --json {0}/r.json", dir, file));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("classified on the model"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("check: valid"), std::string::npos) << r.output;
+  // The output carries the model's classification: classifying it again
+  // changes nothing, and its boundary is on the model.
+  const auto model = geom_occ::load_model(file);
+  mesh::TetMesh out = io::read_mesh(dir + "/out.msh");
+  const auto c = generate::classify_on_model(out, *model);
+  SCOPED_TRACE(summary(c));
+  EXPECT_EQ(c.vertices_changed, 0u);
+  EXPECT_EQ(c.triangles_changed, 0u);
+  EXPECT_EQ(c.edges_changed, 0u);
+  EXPECT_EQ(c.num_problems, 0u);
+  expect_valid_on_model(out, *model, 2);
 }
