@@ -259,6 +259,37 @@ INSTANTIATE_TEST_SUITE_P(
                       BuiltinCase{"builtin:inclusion", 0.35, Scramble::kPermute, 10}),
     builtin_case_name);
 
+TEST(ClassifyOnModel, PhysicalGroupsFollowTheirElements) {
+  const auto model = geom_occ::load_model("builtin:cylinder");
+  const mesh::TetMesh original = generate::mesh_volume(*model, size::UniformSizeField(0.4));
+  mesh::TetMesh m = original;
+  make_foreign(m, Scramble::kPermute);  // input face 1000 - f is model face f
+  for (auto& e : m.entities) {
+    if (e.dim == 2) e.physicals = {10 + 1000 - e.tag};
+    if (e.dim == 3) e.physicals = {99};
+    if (e.dim == 3) e.name = "solid";
+  }
+  auto c = generate::classify_on_model(m, *model);
+  EXPECT_EQ(c.num_problems, 0u) << summary(c);
+  for (const auto& e : m.entities) {
+    if (e.dim == 2) {
+      EXPECT_EQ(e.physicals, std::vector<std::int32_t>{10 + e.tag}) << "face " << e.tag;
+    } else if (e.dim == 3) {
+      EXPECT_EQ(e.physicals, std::vector<std::int32_t>{99});
+      EXPECT_EQ(e.name, "solid");
+    }
+  }
+  // Two input faces with different groups onto one model face: both
+  // groups, and a warning.
+  m = original;
+  make_foreign(m, Scramble::kSplit);
+  for (auto& e : m.entities)
+    if (e.dim == 2) e.physicals = {e.tag};
+  c = generate::classify_on_model(m, *model);
+  ASSERT_GT(c.num_problems, 0u);
+  EXPECT_NE(c.problems.front().find("with different physical groups"), std::string::npos) << c.problems.front();
+}
+
 TEST(ClassifyOnModel, OwnMshFileGivesBackItsClassification) {
   // The whole path a user takes: curvemesh's mesh of a shared model written
   // to MSH 4.1, read back, classified again.
@@ -440,6 +471,35 @@ TEST(ClassifyOnModel, GmshMeshOfAnotherShapeIsOneClearError) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   mesh::TetMesh m = io::read_mesh(dir + "/t20.msh");
   EXPECT_THROW(generate::classify_on_model(m, *model, {dir + "/t20.msh"}), InputError);
+}
+
+TEST(ClassifyOnModel, GmshMeshWithItsSeamElsewhere) {
+  // The same cylinder as builtin:cylinder, turned by 60 degrees about its
+  // axis: Gmsh's seam and circle vertices are not the model's. Its vertices
+  // there go on the model's face and circles, and what the mesh lacks (a
+  // mesh of the model's seam, vertices at the model's vertices) is reported.
+  if (!have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
+  const std::string dir = test::make_temp_dir("classify_seam");
+  std::ofstream(dir + "/cylinder.geo") << "SetFactory(\"OpenCASCADE\");\nCylinder(1) = {0, 0, 0, 0, 0, 2, 1};\n"
+                                          "Rotate {{0, 0, 1}, {0, 0, 0}, Pi/3} { Volume{1}; }\n";
+  const auto r = test::run_command(fmt::format("{} -3 -nt 1 -order 2 -setnumber Mesh.MeshSizeMax 0.3 '{}/cylinder.geo' "
+                                               "-o '{}/cylinder.msh' -format msh41",
+                                               CM_GMSH_EXECUTABLE, dir, dir));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto model = geom_occ::load_model("builtin:cylinder");
+  mesh::TetMesh m = io::read_mesh(dir + "/cylinder.msh");
+  const auto c = generate::classify_on_model(m, *model);
+  SCOPED_TRACE(summary(c));
+  EXPECT_EQ(c.vertices_on_model_vertices, 0u);
+  EXPECT_EQ(c.num_problems, 3u);
+  std::size_t seam = 0, corners = 0;
+  for (const auto& p : c.problems) {
+    seam += p.find("has no mesh edge") != std::string::npos;
+    corners += p.find("has no mesh vertex") != std::string::npos;
+  }
+  EXPECT_EQ(seam, 1u);
+  EXPECT_EQ(corners, 2u);
+  expect_valid_on_model(m, *model, 0.3);
 }
 
 // --- the optimize command ------------------------------------------------------

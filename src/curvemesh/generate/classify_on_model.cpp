@@ -461,7 +461,8 @@ ModelClassification classify_on_model(mesh::TetMesh& m, const geom::Model& model
   const Timer timer;
   if (m.num_tets() == 0) throw InputError(o.mesh_name, -1, -1, "the mesh has no tetrahedra to classify");
   CM_ASSERT_OP(m.tet2adj.size(), ==, 4 * m.num_tets());
-  CM_ASSERT_OP(m.vert_class.size(), ==, m.num_verts());
+  CM_ASSERT_OP(m.vert2tet.size(), ==, m.num_verts());
+  m.resize_vertex_arrays();
   ModelClassification res;
   Problems problems(res.problems, res.num_problems, o.max_problems);
   const ModelIndex ix(model);
@@ -542,8 +543,8 @@ ModelClassification classify_on_model(mesh::TetMesh& m, const geom::Model& model
                             edges_of.of(static_cast<VertId>(v)), face_proj, edge_proj, true);
   });
   // A model vertex takes the nearest mesh vertex; one farther off inside a
-  // single model edge (shorter than the vertex's tolerance) goes on the edge.
-  // Mesh vertices as near (each region's copy where the regions do not
+  // single model edge (shorter than the vertex's tolerance) or face goes on
+  // it. Mesh vertices as near (each region's copy where the regions do not
   // conform) or where model edges meet stay on the model vertex.
   {
     std::map<int, VertId> nearest;
@@ -554,7 +555,7 @@ ModelClassification classify_on_model(mesh::TetMesh& m, const geom::Model& model
     }
     for (VertId v = 0; v < nv; ++v) {
       if (vr[v].on.dim != 0 || vr[v].distance <= vr[nearest[vr[v].on.tag]].distance) continue;
-      if (edges_of.of(v).size() == 1)
+      if (edges_of.of(v).size() <= 1)
         vr[v] = classify_vertex(ix, m.coords[v], v, faces_of.of(v), edges_of.of(v), face_proj, edge_proj, false);
     }
   }

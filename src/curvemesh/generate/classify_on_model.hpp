@@ -28,12 +28,12 @@ struct ModelClassification {
   // Boundary triangles: hull faces and faces between model regions.
   std::size_t boundary_triangles = 0;
   std::size_t input_faces = 0;          ///< distinct input face tags among them
-  /// Input triangles inside a model region (an embedded face the model does
-  /// not have, or between input regions that map to one), left out of m.tris.
-  std::size_t triangles_dropped = 0;
   std::size_t input_faces_whole = 0;    ///< of them, those whose triangles all fit one model face
   std::size_t triangles_searched = 0;   ///< placed one by one (their group fit no single face, or no tag)
   std::size_t triangles_flipped = 0;    ///< listed reversed from the input, to follow the face's normal
+  /// Input triangles inside a model region (an embedded face the model does
+  /// not have, or between input regions that map to one), left out of m.tris.
+  std::size_t triangles_dropped = 0;
   std::vector<TagMapping> face_map;     ///< per input face tag, by increasing tag
   std::vector<TagMapping> region_map;   ///< per input region tag
   // Vertices by the dimension of their model entity.
@@ -48,11 +48,13 @@ struct ModelClassification {
   // Fit: each boundary vertex against its entity evaluated at its parameters.
   double max_distance = 0;           ///< in model length units
   double max_relative_distance = 0;  ///< over the entity's tolerance (generate::check_boundary's measure)
-  /// Inconsistencies that leave every vertex on the model but the
-  /// classification short of a geometric triangulation (a model entity with
-  /// no mesh entity, a mesh edge spanning two model edges, a vertex where
-  /// model edges meet away from a model vertex, input physical groups merged
-  /// onto one model entity...). The first few, each naming the entities.
+  /// Inconsistencies that leave the classification short of a geometric
+  /// triangulation of the model but the mesh usable: a model entity with no
+  /// mesh entity, a face two regions share where the mesh does not conform
+  /// (each region meshed on its own), a mesh edge spanning two model edges,
+  /// a vertex where model edges meet away from a model vertex, vertices off
+  /// their entity by more than its tolerance (within twice), input physical
+  /// groups merged onto one model entity. The first few, naming entities.
   std::vector<std::string> problems;
   std::size_t num_problems = 0;
   double seconds = 0;
@@ -69,9 +71,11 @@ struct ClassifyOptions {
 ///   few of its tets (geom::Model::classify_point on their centroids);
 /// - m.tris: the hull faces and the faces between tets of different model
 ///   regions, each on the model face all three of its vertices lie on
-///   (within the face's tolerance raised to its edges' and vertices'),
-///   listed to follow face_normal (out of the face's first region, as
-///   generate::check_boundary expects). Triangles of one input face tag are
+///   (within the face's tolerance, or twice its edges' and vertices': a
+///   surface may miss its own corner by the corner's tolerance), listed to
+///   follow face_normal (out of the face's first region, as
+///   generate::check_boundary expects; also where two regions' meshes meet
+///   on a shared face without conforming). Triangles of one input face tag are
 ///   tried on one model face together (candidates pruned by bounding box);
 ///   those that do not fit it are placed one by one, so a many-to-one or
 ///   one-to-many tag correspondence comes out right;
@@ -79,8 +83,9 @@ struct ClassifyOptions {
 ///   model faces meet, and on seams and other edges that bound one face
 ///   only — each on the model edge its end points and its midpoint (or
 ///   high-order nodes, when the mesh has them) lie on;
-/// - vert_class / vert_param: {0, V} at a model vertex's point, {1, E} with
-///   u along mesh edges of model edge E, {2, F} with (u, v) inside model face
+/// - vert_class / vert_param: {0, V} within V's tolerance of its point (the
+///   nearest such mesh vertex, others inside a shorter model edge go on it),
+///   {1, E} with u along mesh edges of model edge E, {2, F} with (u, v) inside model face
 ///   F (as closest_point returns them: periodic directions wrapped into the
 ///   face's range), {3, region} inside; model vertices carry no parameters;
 /// - m.entities: the model's topology (bounding entities signed as
@@ -88,8 +93,9 @@ struct ClassifyOptions {
 ///   the input entities that map to each.
 /// A mesh curvemesh made of `model` gets back exactly the classification it
 /// was written with (up to parameter round-off and periods).
-/// Preconditions: adjacency built (mesh::build_adjacency); conforming,
-/// positive tets. High-order nodes are kept as they are (unmoved).
+/// Preconditions: adjacency and vert2tet built (mesh::build_adjacency, as
+/// io::read_mesh does); positive tets. High-order nodes are kept as they are
+/// (unmoved); the vertex arrays are resized to #V.
 /// On success the boundary passes check_boundary's vertex test for any mesh
 /// made from the model by a tool that puts vertices on it.
 /// Throws cm::InputError (file = options.mesh_name), leaving m unchanged,
