@@ -25,6 +25,7 @@
 #include "curvemesh/mesh/classification.hpp"
 #include "curvemesh/mesh/structured.hpp"
 #include "curvemesh/mesh/validate.hpp"
+#include "curvemesh/size/build.hpp"
 #include "curvemesh/size/size_field.hpp"
 
 using namespace cm;
@@ -131,7 +132,31 @@ void expect_same_classification(const mesh::TetMesh& original, const mesh::TetMe
   }
 }
 
+// Parameters inside their entity's range, periodic directions wrapped into
+// [u0, u0 + period): what the curving step interpolates between neighbours.
+std::size_t params_out_of_range(const mesh::TetMesh& m, const geom::Model& model) {
+  std::size_t out = 0;
+  const auto inside = [](double t, double lo, double hi, bool periodic, double period) {
+    if (periodic && period > 0) return t >= lo && t < lo + period;
+    const double slack = 1e-9 * std::max(1.0, hi - lo);
+    return t >= lo - slack && t <= hi + slack;
+  };
+  for (VertId v = 0; v < m.num_verts(); ++v) {
+    const mesh::ModelRef c = m.vert_class[v];
+    if (c.dim != 1 && c.dim != 2) continue;
+    const geom::ParamRange r = model.param_range({c.dim, c.tag});
+    const bool ok = inside(m.vert_param[v].u, r.u0, r.u1, r.periodic_u, r.period_u) &&
+                    (c.dim == 1 || inside(m.vert_param[v].v, r.v0, r.v1, r.periodic_v, r.period_v));
+    if (!ok && ++out <= 3)
+      ADD_FAILURE() << "vertex " << v << " on (" << c.dim << ", " << c.tag << "): (" << m.vert_param[v].u << ", "
+                    << m.vert_param[v].v << ") outside [" << r.u0 << ", " << r.u1 << "] x [" << r.v0 << ", " << r.v1
+                    << "]";
+  }
+  return out;
+}
+
 void expect_valid_on_model(const mesh::TetMesh& m, const geom::Model& model, double h) {
+  EXPECT_EQ(params_out_of_range(m, model), 0u);
   const auto rep = mesh::validate(m, mesh::Level::kFull);
   EXPECT_TRUE(rep.valid()) << rep.num_issues << " issues, first: " << (rep.issues.empty() ? "" : rep.issues.front().message);
   const size::UniformSizeField size(h);
@@ -290,18 +315,30 @@ TEST(ClassifyOnModel, PhysicalGroupsFollowTheirElements) {
   EXPECT_NE(c.problems.front().find("with different physical groups"), std::string::npos) << c.problems.front();
 }
 
-TEST(ClassifyOnModel, OwnMshFileGivesBackItsClassification) {
+class OwnMshFile : public ::testing::TestWithParam<const char*> {};
+
+std::string model_case_name(const ::testing::TestParamInfo<const char*>& p) {
+  std::string n = p.param;
+  n = n.substr(0, n.find('.'));
+  for (char& ch : n)
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+  return n;
+}
+
+TEST_P(OwnMshFile, GivesBackItsClassification) {
   // The whole path a user takes: curvemesh's mesh of a shared model written
-  // to MSH 4.1, read back, classified again.
-  const std::string file = models_dir() + "/t20_data.step";
+  // to MSH 4.1, read back, classified again: nothing changes.
+  const std::string file = models_dir() + "/" + GetParam();
   if (!std::filesystem::exists(file)) GTEST_SKIP() << "no shared model " << file;
   const auto model = geom_occ::load_model(file);
-  const size::UniformSizeField size(model->bounding_box().diagonal() / 10);
-  const mesh::TetMesh original = generate::mesh_volume(*model, size);
+  size::SizeOptions so;  // curvature-graded, as `curvemesh mesh --hmax` sizes it
+  so.hmax = model->bounding_box().diagonal() / 15;
+  const size::SizeFieldResult size = size::build_size_field(*model, so);
+  const mesh::TetMesh original = generate::mesh_volume(*model, *size.field);
   const std::string dir = test::make_temp_dir("classify_own");
-  io::write_mesh(original, dir + "/t20.msh");
-  mesh::TetMesh m = io::read_mesh(dir + "/t20.msh");
-  const auto c = generate::classify_on_model(m, *model);
+  io::write_mesh(original, dir + "/own.msh");
+  mesh::TetMesh m = io::read_mesh(dir + "/own.msh");
+  const auto c = generate::classify_on_model(m, *model, {dir + "/own.msh"});
   SCOPED_TRACE(summary(c));
   EXPECT_EQ(c.vertices_changed, 0u);
   EXPECT_EQ(c.triangles_changed, 0u);
@@ -377,14 +414,6 @@ void check_gmsh_mesh(const std::string& name, const std::string& path, double h,
 
 class GmshMesh : public ::testing::TestWithParam<const char*> {};
 
-std::string model_case_name(const ::testing::TestParamInfo<const char*>& p) {
-  std::string n = p.param;
-  n = n.substr(0, n.find('.'));
-  for (char& ch : n)
-    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-  return n;
-}
-
 TEST_P(GmshMesh, ClassifiedBoundaryPassesTheCheck) {
   if (!have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
   const std::string file = models_dir() + "/" + GetParam();
@@ -404,12 +433,12 @@ TEST_P(GmshMesh, ClassifiedBoundaryPassesTheCheck) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(SharedModels, GmshMesh,
-                         ::testing::Values("1385_Laufrad_1000.stp", "917_fusee.stp",
-                                           "918_pump_carter_sup_21_03_2006.stp", "SampleCrankshaft4A.stp",
-                                           "Torus_1.brep", "Zylkopf.stp", "dlr_f6.brep", "full_sphere.brep",
-                                           "metallmeister_gear.step", "ring.brep", "t20_data.step"),
-                         model_case_name);
+const auto kSharedModels =
+    ::testing::Values("1385_Laufrad_1000.stp", "917_fusee.stp", "918_pump_carter_sup_21_03_2006.stp",
+                      "SampleCrankshaft4A.stp", "Torus_1.brep", "Zylkopf.stp", "dlr_f6.brep", "full_sphere.brep",
+                      "metallmeister_gear.step", "ring.brep", "t20_data.step");
+INSTANTIATE_TEST_SUITE_P(SharedModels, OwnMshFile, kSharedModels, model_case_name);
+INSTANTIATE_TEST_SUITE_P(SharedModels, GmshMesh, kSharedModels, model_case_name);
 
 // --- meshes of another model --------------------------------------------------
 

@@ -61,6 +61,8 @@ ModelIndex::ModelIndex(const geom::Model& g) : model(g) {
   face_vertices.resize(nf + 1);
   face_regions.resize(nf + 1);
   edge_ends.assign(ne + 1, {0, 0});
+  edge_range.resize(ne + 1);
+  face_range.resize(nf + 1);
   for (int v = 1; v <= nv; ++v) {
     vertex_tol[v] = std::max(g.tolerance({0, v}), floor);
     max_vertex_tol_ = std::max(max_vertex_tol_, vertex_tol[v]);
@@ -69,6 +71,7 @@ ModelIndex::ModelIndex(const geom::Model& g) : model(g) {
   std::sort(vertex_by_x_.begin(), vertex_by_x_.end());
   for (int e = 1; e <= ne; ++e) {
     edge_ends[e] = g.edge_vertices(e);
+    edge_range[e] = g.param_range({1, e});
     edge_tol[e] = std::max(g.tolerance({1, e}), floor);
     edge_reach[e] = edge_tol[e];
     for (const int v : edge_ends[e])
@@ -76,6 +79,7 @@ ModelIndex::ModelIndex(const geom::Model& g) : model(g) {
   }
   for (int f = 1; f <= nf; ++f) {
     face_tol[f] = std::max(g.tolerance({2, f}), floor);
+    face_range[f] = g.param_range({2, f});
     face_reach[f] = face_tol[f];
     for (const geom::Loop& loop : g.face_loops(f))
       for (const geom::OrientedUse& use : loop.edges) {
@@ -138,6 +142,17 @@ ModelIndex::ModelIndex(const geom::Model& g) : model(g) {
           }
     }
   }
+}
+
+Vec2 ModelIndex::normalized(int dim, int tag, Vec2 param) const {
+  const geom::ParamRange& r = dim == 1 ? edge_range[tag] : face_range[tag];
+  const auto wrap = [](double t, double lo, double period) {
+    t -= std::floor((t - lo) / period) * period;
+    return t >= lo + period ? t - period : t;
+  };
+  if (r.periodic_u && r.period_u > 0) param.x() = wrap(param.x(), r.u0, r.period_u);
+  if (dim == 2 && r.periodic_v && r.period_v > 0) param.y() = wrap(param.y(), r.v0, r.period_v);
+  return param;
 }
 
 std::span<const int> ModelIndex::faces_near(const Vec3& x) const {

@@ -390,8 +390,9 @@ VertexResult classify_vertex(const ModelIndex& ix, const Vec3& x, VertId v, std:
     return r;
   }
   r.on = {dim, best->entity};
-  r.param.u = best->param.x();
-  if (dim == 2) r.param.v = best->param.y();
+  const Vec2 param = ix.normalized(dim, best->entity, best->param);
+  r.param.u = param.x();
+  if (dim == 2) r.param.v = param.y();
   r.distance = best->distance;
   r.tolerance = (dim == 1 ? ix.edge_tol : ix.face_tol)[best->entity];
   if (tags.size() > 1) r.issue = dim == 1 ? VertexResult::Issue::kEdgesWithoutVertex : VertexResult::Issue::kFacesWithoutEdge;

@@ -33,6 +33,13 @@ struct ModelIndex {
   std::vector<std::vector<int>> face_vertices;   ///< of every edge of the face, sorted
   std::vector<std::vector<int>> face_regions;    ///< upward, first region first
   std::vector<std::array<int, 2>> edge_ends;
+  std::vector<geom::ParamRange> edge_range, face_range;
+
+  /// Parameters of a point on the edge or face with periodic directions
+  /// wrapped into the entity's range, [u0, u0 + period): closest_point may
+  /// answer a period or two off (geom_occ on some closed faces), and
+  /// neighbours' parameters are interpolated by the curving step.
+  Vec2 normalized(int dim, int tag, Vec2 param) const;
 
   /// Faces whose inflated box may hold x (a superset; test the boxes).
   std::span<const int> faces_near(const Vec3& x) const;
