@@ -1,8 +1,9 @@
-// classify_on_model: exact counts on a structured box, curvemesh's own meshes
-// of the builtins (with their tags scrambled, merged and split) and of a
+// classify_on_model: exact counts on structured boxes, curvemesh's own meshes
+// of the builtins (with their tags scrambled, merged and split) and of every
 // shared model through MSH given back exactly as written, Gmsh's meshes of
-// every shared model (orders 1 and 2) passing the boundary check, the
-// optimize command on a Gmsh mesh with --model, and meshes of another model.
+// every shared model (orders 1 and 2) passing the boundary check, physical
+// groups, a Gmsh mesh whose seam is not the model's, meshes of other models,
+// and the optimize command on a Gmsh mesh with --model.
 #include <gtest/gtest.h>
 
 #include <cmath>
