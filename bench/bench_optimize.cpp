@@ -11,7 +11,11 @@
 // with Mesh.Optimize 1 and Mesh.OptimizeNetgen 1: the same tetrahedra
 // (meshing is deterministic with one thread) and then its optimizers, whose
 // own time is read from its log ("Done optimizing mesh (Wall w, CPU c)").
-// A third row per model runs ours on the input with its interior vertices
+// Another row runs ours with the model (`curvemesh optimize --model`): the
+// Gmsh mesh classified on it (generate::classify_on_model, its time in the
+// JSON record), then boundary vertices moved on their model face or edge.
+// Gmsh is told the model's length unit so that its mesh and H are in it.
+// A last row per model runs ours on the input with its interior vertices
 // moved at random (kept positive) and some pushed almost flat.
 // Times are CPU seconds of the optimization alone (the machine may be
 // shared; wall time follows in the JSON records).
@@ -40,6 +44,8 @@
 
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/core/timer.hpp"
+#include "curvemesh/generate/classify_on_model.hpp"
+#include "curvemesh/geom_occ/load.hpp"
 #include "curvemesh/io/mesh_io.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/structured.hpp"
@@ -59,6 +65,7 @@ using cm::optimize::MeshSummary;
 struct Case {
   fs::path file;
   double h = 0;  // > 0: a model, meshed by Gmsh at this MeshSizeMax
+  std::string units;  // the model's, once loaded
 };
 
 struct Row {
@@ -68,6 +75,7 @@ struct Row {
   double cpu = 0, wall = 0;
   bool ok = false, valid = true;
   std::string note;
+  double classify_s = 0;  // classification on the model (wall), before the optimization
 };
 
 double cpu_now() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
@@ -94,9 +102,9 @@ void gmsh_optimizer_times(const fs::path& log, double& wall, double& cpu) {
 std::string gmsh_command(const Case& c, const fs::path& out, bool optimize) {
   return fmt::format(
       "gmsh -3 -nt 1 -setnumber Mesh.Optimize {0} -setnumber Mesh.OptimizeNetgen {0} "
-      "-setnumber Mesh.MeshSizeFromCurvature 12 -setnumber Mesh.MeshSizeMax {1} '{2}' -o '{3}' -format msh41 "
+      "-setnumber Mesh.MeshSizeFromCurvature 12 -setnumber Mesh.MeshSizeMax {1}{4} '{2}' -o '{3}' -format msh41 "
       "> '{3}.log' 2>&1",
-      optimize ? 1 : 0, c.h, c.file.string(), out.string());
+      optimize ? 1 : 0, c.h, c.file.string(), out.string(), cm::bench::gmsh_unit_option(c.units));
 }
 
 // Random interior moves that keep every tet positive, then some vertices
@@ -158,7 +166,8 @@ double sharpest_wedge(const cm::mesh::TetMesh& m) {
   return lo;
 }
 
-Row optimize_ours(const std::string& name, const std::string& who, cm::mesh::TetMesh m) {
+Row optimize_ours(const std::string& name, const std::string& who, cm::mesh::TetMesh m,
+                  const cm::geom::Model* model = nullptr) {
   Row r{name, who, {}, {}, {}, 0, 0, false, true, {}};
   r.before = cm::optimize::summarize_mesh(m);
   const double c0 = cpu_now();
@@ -166,6 +175,7 @@ Row optimize_ours(const std::string& name, const std::string& who, cm::mesh::Tet
   cm::optimize::ImproveOptions o;
   o.threshold = 0.6;  // as `curvemesh optimize`
   o.passes = 8;
+  o.model = model;
   cm::optimize::improve_quality(m, o);
   r.wall = wall.seconds();
   r.cpu = cpu_now() - c0;
@@ -227,7 +237,7 @@ nlohmann::json to_json(const Row& r) {
                                 {"free_min_mean_ratio", l.free_min_mean_ratio}};
   return {{"case", r.name},       {"optimizer", r.who},     {"ok", r.ok},       {"valid", r.valid},
           {"cpu_s", r.cpu},       {"wall_s", r.wall},       {"before", s(r.before)}, {"after", s(r.after)},
-          {"boundary_limit", limit}, {"note", r.note}};
+          {"boundary_limit", limit}, {"note", r.note}, {"classify_s", r.classify_s}};
 }
 
 // Adaptation to analytic fields on the unit box: a shock-like isotropic
@@ -301,7 +311,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     fs::path f = argv[i];
     if (!fs::exists(f)) f = cm::bench::models_dir() / argv[i];
-    Case c{f, 0};
+    Case c{f, 0, {}};
     const std::string ext = f.extension().string();
     const bool is_mesh = ext == ".msh" || ext == ".mesh" || ext == ".meshb";
     if (!is_mesh && i + 1 < argc) c.h = std::atof(argv[++i]);
@@ -312,7 +322,7 @@ int main(int argc, char** argv) {
     cases.push_back(c);
   }
   if (cases.empty()) {
-    cases = {{cm::bench::models_dir() / "t20_data.step", 1.2}, {cm::bench::models_dir() / "Zylkopf.stp", 0.65}};
+    cases = {{cm::bench::models_dir() / "t20_data.step", 1.2, {}}, {cm::bench::models_dir() / "Zylkopf.stp", 0.65, {}}};
   }
   // How many of the worst tets left under 10 degrees to list per row.
   const std::size_t worst_listed = std::getenv("CM_BENCH_WORST") ? std::stoul(std::getenv("CM_BENCH_WORST")) : 3;
@@ -329,10 +339,18 @@ int main(int argc, char** argv) {
              "case", "optimizer", "tets in", "minq", "mindih", "tets out", "cpu s", "minq", "meanq", "mindih",
              "maxdih", "t/ours", "pin", "pin dih", "pin cap", "free<", "freeq", "freedih");
   std::vector<Row> rows;
-  for (const Case& c : cases) {
+  for (Case& c : cases) {
     const std::string name = c.file.filename().string() + (c.h > 0 ? fmt::format(" H={}", c.h) : "");
     fs::path input = c.file;
+    std::unique_ptr<cm::geom::Model> model;
     if (c.h > 0) {
+      try {
+        model = cm::geom_occ::load_model(c.file.string());
+        c.units = model->units();
+      } catch (const std::exception& e) {
+        fmt::print("{:<28} cannot load the model: {}\n", name, e.what());
+        continue;
+      }
       if (!have_gmsh) {
         fmt::print("{:<28} skipped: gmsh is not on PATH to mesh the model\n", name);
         continue;
@@ -357,6 +375,23 @@ int main(int argc, char** argv) {
     print_worst(ours, worst_listed);
     rows.push_back(ours);
 
+    if (model) {
+      cm::mesh::TetMesh on_model = m;
+      try {
+        const auto cls = cm::generate::classify_on_model(on_model, *model, {input.string()});
+        Row r = optimize_ours(name, "cm+model", std::move(on_model), model.get());
+        r.classify_s = cls.seconds;
+        if (cls.num_problems) r.note = fmt::format("{} classification warnings", cls.num_problems);
+        print_row(r, ours.cpu);
+        fmt::print("    classified on the model in {:.3f} s: {} vertices, {} triangles, {} tets reclassified{}\n",
+                   cls.seconds, cls.vertices_changed, cls.triangles_changed, cls.tets_changed,
+                   cls.problems.empty() ? "" : "; first warning: " + cls.problems.front());
+        print_worst(r, worst_listed);
+        rows.push_back(r);
+      } catch (const std::exception& e) {
+        fmt::print("{:<28} {:<10} cannot classify it on the model: {}\n", name, "cm+model", e.what());
+      }
+    }
     if (c.h > 0) {
       Row g{name, "gmsh", ours.before, {}, {}, 0, 0, false, true, {}};
       const fs::path out = tmp / "gmsh_opt.msh";

@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/core/timer.hpp"
+#include "curvemesh/generate/classify_on_model.hpp"
 #include "curvemesh/geom_occ/load.hpp"
 #include "curvemesh/io/atomic_file.hpp"
 #include "curvemesh/io/formats.hpp"
@@ -242,6 +243,50 @@ std::string render_lengths(const optimize::LengthStats& l) {
   return s;
 }
 
+nlohmann::json classification_json(const generate::ModelClassification& c) {
+  nlohmann::json faces = nlohmann::json::array(), regions = nlohmann::json::array();
+  for (const auto& f : c.face_map)
+    faces.push_back({{"input", f.input}, {"model", f.model}, {"triangles", f.count}, {"elsewhere", f.others}});
+  for (const auto& r : c.region_map) regions.push_back({{"input", r.input}, {"model", r.model}, {"tets", r.count}});
+  return {{"boundary_triangles", c.boundary_triangles},
+          {"input_faces", c.input_faces},
+          {"input_faces_whole", c.input_faces_whole},
+          {"triangles_searched", c.triangles_searched},
+          {"triangles_dropped", c.triangles_dropped},
+          {"triangles_flipped", c.triangles_flipped},
+          {"vertices_on_model_vertices", c.vertices_on_model_vertices},
+          {"vertices_on_model_edges", c.vertices_on_model_edges},
+          {"vertices_on_model_faces", c.vertices_on_model_faces},
+          {"interior_vertices", c.interior_vertices},
+          {"mesh_edges_on_model_edges", c.mesh_edges_on_model_edges},
+          {"changed", {{"vertices", c.vertices_changed}, {"triangles", c.triangles_changed}, {"edges", c.edges_changed},
+                       {"tets", c.tets_changed}}},
+          {"max_distance", c.max_distance},
+          {"max_distance_over_tolerance", c.max_relative_distance},
+          {"face_map", faces},
+          {"region_map", regions},
+          {"problems", c.problems},
+          {"num_problems", c.num_problems},
+          {"seconds", c.seconds}};
+}
+
+std::string render_classification(const generate::ModelClassification& c) {
+  std::string s = fmt::format(
+      "classified on the model: {} boundary triangles from {} input faces, {} of them whole on one model face{}{}; "
+      "boundary vertices: {} on model vertices, {} on model edges, {} on model faces; {} mesh edges on model edges\n"
+      "  changed: {} vertices, {} triangles ({} reversed), {} mesh edges, {} tets; farthest vertex {:.3g} from its "
+      "entity ({:.3g} of its tolerance); {:.2f} s\n",
+      c.boundary_triangles, c.input_faces, c.input_faces_whole,
+      c.triangles_searched ? fmt::format(", {} triangles placed one by one", c.triangles_searched) : "",
+      c.triangles_dropped ? fmt::format(", {} inside the model dropped", c.triangles_dropped) : "",
+      c.vertices_on_model_vertices, c.vertices_on_model_edges, c.vertices_on_model_faces, c.mesh_edges_on_model_edges,
+      c.vertices_changed, c.triangles_changed, c.triangles_flipped, c.edges_changed, c.tets_changed, c.max_distance,
+      c.max_relative_distance, c.seconds);
+  for (const auto& p : c.problems) s += "  warning: " + p + "\n";
+  if (c.num_problems > c.problems.size()) s += fmt::format("  ... {} more warnings\n", c.num_problems - c.problems.size());
+  return s;
+}
+
 std::string boundary_policy(bool adapt, bool model) {
   if (!model) return adapt ? "kept (boundary vertices fixed; boundary edges split at their midpoints)"
                            : "kept (boundary vertices and triangles unchanged)";
@@ -275,6 +320,21 @@ int run_optimize(const OptimizeCliOptions& o) {
   std::unique_ptr<geom::Model> model;
   if (!o.model.empty()) model = geom_occ::load_model(o.model, {});
   const double read_s = step.seconds();
+
+  // The mesh's own tags need not be the model's (another tool's mesh of
+  // it): the model's classification is found by geometry.
+  std::optional<generate::ModelClassification> classified;
+  if (model) {
+    classified = generate::classify_on_model(m, *model, {o.input});
+    const auto recheck = mesh::validate(m, mesh::Level::kFull, 1);
+    if (!recheck.valid())
+      throw InputError(o.input, -1, -1,
+                       fmt::format("its classification on the model {} is not consistent ({}{}); optimize it "
+                                   "without --model to keep its boundary as it is",
+                                   o.model, recheck.issues.empty() ? "" : recheck.issues.front().message,
+                                   classified->problems.empty() ? "" : "; " + classified->problems.front()));
+  }
+  const double classify_s = classified ? classified->seconds : 0;
 
   step.reset();
   std::optional<SizeSpec> spec = make_metric(o, m);
@@ -374,14 +434,16 @@ int run_optimize(const OptimizeCliOptions& o) {
                         {"insertion", iso.insertion_seconds}}}};
     op_seconds = iso.seconds;
   }
+  if (classified) j["classification"] = classification_json(*classified);
   j["boundary"] = boundary_policy(metric != nullptr, model != nullptr);
   j["boundary_limit"] = limit_json(limit);
-  j["seconds"] = {{"read", read_s},         {"metric", metric_s}, {"optimize", optimize_s}, {"check", check_s},
-                  {"write", write_s},       {"total", total.seconds()}};
+  j["seconds"] = {{"read", read_s},   {"classify", classify_s}, {"metric", metric_s}, {"optimize", optimize_s},
+                  {"check", check_s}, {"write", write_s},       {"total", total.seconds()}};
   if (!o.json_path.empty()) write_json(j, o.json_path);
 
   if (!o.quiet) {
     fmt::print("mesh: {}  ({} mode{})\n", o.input, mode, model ? fmt::format(", model {}", o.model) : "");
+    if (classified) fmt::print("{}", render_classification(*classified));
     auto line = [&](const char* label, const optimize::MeshSummary& s) {
       fmt::print("  {:<7} {:>8} vertices {:>9} tets  mean ratio min {:.4f} mean {:.4f}  dihedral min {:6.2f} max "
                  "{:6.2f} deg",
@@ -418,9 +480,9 @@ int run_optimize(const OptimizeCliOptions& o) {
     if (!ok) fmt::print(" ({} inverted, {} flat, {} other issues)", check.num_inverted, check.num_flat,
                         check.num_issues - check.num_inverted - check.num_flat);
     fmt::print("\n");
-    fmt::print("time: read {:.2f} s, metric {:.2f} s, optimize {:.2f} s (operators {:.2f} s), check {:.2f} s, write "
-               "{:.2f} s, total {:.2f} s\n",
-               read_s, metric_s, optimize_s, op_seconds, check_s, write_s, total.seconds());
+    fmt::print("time: read {:.2f} s, classify {:.2f} s, metric {:.2f} s, optimize {:.2f} s (operators {:.2f} s), "
+               "check {:.2f} s, write {:.2f} s, total {:.2f} s\n",
+               read_s, classify_s, metric_s, optimize_s, op_seconds, check_s, write_s, total.seconds());
     fmt::print("wrote {}\n", o.output);
   }
   return ok ? kExitOk : kExitInvalidMesh;
@@ -463,9 +525,11 @@ void add_optimize_command(CLI::App& app, Runner& runner) {
       "Without --model the boundary surface, its classification and reference tags, and the enclosed\n"
       "volume are kept: boundary vertices never move and boundary triangles are never swapped; with a\n"
       "size map or a metric, edges are split and collapsed toward unit length in it ([0.7, 1.4]),\n"
-      "boundary edges split at their midpoints and boundary vertices never removed. With --model (its\n"
-      "tags those of the mesh's classification) boundary vertices move on their model face or edge,\n"
-      "new boundary points go onto the model and boundary vertices may collapse along it.\n"
+      "boundary edges split at their midpoints and boundary vertices never removed. With --model the\n"
+      "mesh is first classified on the model by geometry (a mesh made from that model by any tool, e.g.\n"
+      "Gmsh, whatever its own tags; the output carries the model's tags), then boundary vertices move on\n"
+      "their model face or edge, new boundary points go onto the model and boundary vertices may\n"
+      "collapse along it. A mesh whose boundary is not on the model is refused (exit code 2).\n"
       "--hgrad <= 0 turns gradation off (default 1.3, applied to any size map).\n"
       "Exit codes: 0 the optimized mesh is valid, 1 it is not (written anyway), 2 bad usage or\n"
       "unreadable input (including an input mesh with inverted tets, or a .sol whose count differs\n"

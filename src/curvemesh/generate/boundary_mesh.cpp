@@ -1,4 +1,5 @@
 #include "curvemesh/generate/boundary_mesh.hpp"
+#include "curvemesh/generate/classify_on_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -147,26 +148,7 @@ mesh::TetMesh mesh_boundary(const geom::Model& model, const size::SizeField& siz
     st.smoothing_moves += fm.smoothing_moves;
   }
 
-  for (int v = 1; v <= nv; ++v) m.entities.push_back({0, v, {}, {}, {}});
-  for (int e = 1; e <= ne; ++e) {
-    const auto v = model.edge_vertices(e);
-    std::vector<std::int32_t> bounding;
-    if (v[0] > 0) bounding.push_back(v[0]);
-    if (v[1] > 0 && v[1] != v[0]) bounding.push_back(-v[1]);
-    m.entities.push_back({1, e, bounding, {}, {}});
-  }
-  for (int f = 1; f <= nf; ++f) {
-    std::vector<std::int32_t> bounding;
-    for (const geom::Loop& loop : model.face_loops(f))
-      for (const geom::OrientedUse& use : loop.edges)
-        if (!model.is_degenerate(use.tag)) bounding.push_back(use.forward ? use.tag : -use.tag);
-    m.entities.push_back({2, f, bounding, {}, {}});
-  }
-  for (int r = 1; r <= model.count(3); ++r) {
-    std::vector<std::int32_t> bounding;
-    for (const geom::OrientedUse& use : model.region_faces(r)) bounding.push_back(use.forward ? use.tag : -use.tag);
-    m.entities.push_back({3, r, bounding, {}, {}});
-  }
+  m.entities = model_entities(model);
   st.assembly_seconds = timer.seconds();
   if (stats) *stats = st;
   return m;
