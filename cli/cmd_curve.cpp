@@ -8,10 +8,12 @@
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/core/timer.hpp"
 #include "curvemesh/curved/element_check.hpp"
+#include "curvemesh/generate/classify_on_model.hpp"
 #include "curvemesh/geom_occ/load.hpp"
 #include "curvemesh/io/mesh_io.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/validate.hpp"
+#include "classification_report.hpp"
 #include "curving.hpp"
 #include "exit_codes.hpp"
 #include "json_output.hpp"
@@ -56,6 +58,15 @@ int run_curve(const CurveCliOptions& o) {
   step.reset();
   const auto model = geom_occ::load_model(o.model, o.model_flags.load_options());
   const double load_s = step.seconds();
+  // Whatever made the mesh, its boundary is classified on the model by
+  // geometry (a mesh of another model, or in other units, is refused here).
+  const generate::ModelClassification classified = generate::classify_on_model(m, *model, {o.input});
+  const auto recheck = mesh::validate(m, mesh::Level::kFull, 1);
+  if (!recheck.valid())
+    throw InputError(o.input, -1, -1,
+                     fmt::format("its classification on the model {} is not consistent ({}{})", o.model,
+                                 recheck.issues.empty() ? "" : recheck.issues.front().message,
+                                 classified.problems.empty() ? "" : "; " + classified.problems.front()));
   step.reset();
   const curved::CurveReport r = curved::curve_mesh(m, *model, o.curving.options());
   const double curve_s = step.seconds();
@@ -73,21 +84,24 @@ int run_curve(const CurveCliOptions& o) {
                          {"unacceptable", input_unacceptable},
                          {"min_scaled_jacobian", input_min_sj}};
   j["counts"] = {{"vertices", m.num_verts()}, {"tets", m.num_tets()}, {"boundary_triangles", m.tris.size()}};
+  j["classification"] = classification_json(classified);
   j["curving"] = curve_report_json(r);
   j["valid"] = ok;
-  j["seconds"] = {{"read", read_s},     {"check_input", check_s}, {"load_model", load_s},
-                  {"curving", curve_s}, {"write", write_s},       {"total", total.seconds()}};
+  j["seconds"] = {{"read", read_s},        {"check_input", check_s}, {"load_model", load_s},
+                  {"classify", classified.seconds}, {"curving", curve_s}, {"write", write_s},
+                  {"total", total.seconds()}};
   if (!o.json_path.empty()) write_json(j, o.json_path);
   if (!o.quiet) {
     fmt::print("mesh: {}  ({} tets, order {})  model: {}\n", o.input, m.num_tets(), input_order, o.model);
     if (input_order > 1)
       fmt::print("input's own nodes: {} certified invalid, {} unacceptable, min scaled Jacobian {:.4f} (replaced)\n",
                  input_invalid, input_unacceptable, input_min_sj);
+    fmt::print("{}", render_classification(classified));
     print_curve_report(r);
     fmt::print("check: {}\n", ok ? "every element certified valid and acceptable" : "INVALID or unacceptable elements remain");
-    fmt::print("time: read {:.2f} s, check input {:.2f} s, load model {:.2f} s, curving {:.2f} s, write {:.2f} s, "
-               "total {:.2f} s\n",
-               read_s, check_s, load_s, curve_s, write_s, total.seconds());
+    fmt::print("time: read {:.2f} s, check input {:.2f} s, load model {:.2f} s, classify {:.2f} s, curving {:.2f} s, "
+               "write {:.2f} s, total {:.2f} s\n",
+               read_s, check_s, load_s, classified.seconds, curve_s, write_s, total.seconds());
     if (!o.output.empty()) fmt::print("wrote {}\n", o.output);
   }
   return ok ? kExitOk : kExitInvalidMesh;
@@ -106,7 +120,9 @@ void add_curve_command(CLI::App& app, Runner& runner) {
   add_model_flags(cmd, o->model_flags);
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
   cmd->footer(
-      "The straight-sided mesh must be valid; high-order nodes it has are replaced by nodes on the model.\n"
+      "The straight-sided mesh must be valid; any tool's mesh of the model will do (its boundary is\n"
+      "classified on the model by geometry first). High-order nodes it has are replaced by nodes on the\n"
+      "model.\n"
       "Exit code 0 when every element is certified valid (det J > 0 everywhere, Bezier bounds) and\n"
       "acceptable, 1 when some are not (written anyway; only with --no-repair), 2 on bad input, 3 on an\n"
       "internal error.\n"

@@ -68,3 +68,24 @@ TEST(CliCurve, BadUseGivesOneErrorAndExitTwo) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.msh"));
   EXPECT_EQ(run_cli("curve " + dir + "/b.msh --model builtin:nosuchshape -q").exit_code, 2);
 }
+
+// Gmsh's own order-2 mesh of a shared model, folded where the torus is
+// coarse (Gmsh 4.8.4 leaves one certified-invalid tet at MeshSizeMax 80):
+// `curve` classifies it on the model, replaces its nodes and repairs it.
+TEST(CliCurve, GmshsFoldedOrderTwoMeshComesOutValid) {
+  if (std::string(CM_GMSH_EXECUTABLE).empty()) GTEST_SKIP() << "gmsh is not installed";
+  const std::string model = std::string(CM_SHARED_DIR) + "/models/Torus_1.brep";
+  if (!std::filesystem::exists(model)) GTEST_SKIP() << "shared models not found";
+  const std::string dir = cm::test::make_temp_dir("curve");
+  const auto g = cm::test::run_command(std::string(CM_GMSH_EXECUTABLE) + " -3 -order 2 " + model +
+                                       " -setnumber Mesh.MeshSizeFromCurvature 12 -setnumber Mesh.MeshSizeMax 80 -format "
+                                       "msh41 -o " + dir + "/g.msh");
+  ASSERT_EQ(g.exit_code, 0) << g.output;
+  const auto r = run_cli("curve " + dir + "/g.msh --model " + model + " -o " + dir + "/c.msh --json " + dir + "/c.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = read_json(dir + "/c.json");
+  EXPECT_GE(j["input_curved"]["invalid"].get<int>(), 1);
+  EXPECT_EQ(j["curving"]["after"]["invalid"].get<int>(), 0);
+  EXPECT_EQ(j["curving"]["after"]["unacceptable"].get<int>(), 0);
+  EXPECT_EQ(run_cli("check " + dir + "/c.msh -q").exit_code, 0);
+}

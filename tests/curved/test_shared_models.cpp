@@ -46,7 +46,8 @@ TEST_P(CurvedSharedModels, OrdersTwoAndThreeEndCertifiedValidAndAcceptable) {
     const curved::CurveReport rep = curved::curve_mesh(m, *r.model, o);
     EXPECT_EQ(rep.after.invalid.size(), 0u) << "order " << order;
     EXPECT_EQ(rep.after.unacceptable.size(), 0u) << "order " << order;
-    EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid()) << "order " << order;
+    const auto v = mesh::validate(m, mesh::Level::kFull);
+    EXPECT_TRUE(v.valid()) << "order " << order << ": " << (v.issues.empty() ? "" : v.issues.front().message);
     RecordProperty("order" + std::to_string(order) + "_unacceptable_before", static_cast<int>(rep.unacceptable_before));
     RecordProperty("order" + std::to_string(order) + "_straightened", static_cast<int>(rep.repair.edges_straightened));
   }

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "cli_runner.hpp"
+#include "../common/gmsh_support.hpp"
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/core/timer.hpp"
 #include "curvemesh/generate/boundary_check.hpp"
@@ -34,7 +35,6 @@ using namespace cm;
 namespace {
 
 std::string models_dir() { return std::string(CM_SHARED_DIR) + "/models"; }
-bool have_gmsh() { return std::string(CM_GMSH_EXECUTABLE).size() > 0; }
 
 std::string summary(const generate::ModelClassification& c) {
   std::string s = fmt::format(
@@ -354,30 +354,6 @@ TEST_P(OwnMshFile, GivesBackItsClassification) {
 
 namespace {
 
-// Gmsh reads STEP in millimetres; curvemesh keeps the file's unit.
-std::string gmsh_unit_option(const std::string& units) {
-  static const std::map<std::string, std::string> kOcc = {{"cm", "CM"}, {"m", "M"}, {"inch", "INCH"}, {"ft", "FT"}};
-  const auto it = kOcc.find(units);
-  return it == kOcc.end() ? "" : " -setstring Geometry.OCCTargetUnit " + it->second;
-}
-
-// Gmsh's order-2 mesh of `input` (the model file, or a .geo merging it) at
-// about the model's diagonal / 15, finer when its volume mesher fails at that
-// size (it does on some models).
-std::string gmsh_mesh(const std::string& input, const geom::Model& model, const std::string& dir, double& h) {
-  h = model.bounding_box().diagonal() / 15;
-  for (int attempt = 0; attempt < 4; ++attempt, h /= 2) {
-    const std::string out = dir + "/gmsh.msh";
-    std::filesystem::remove(out);
-    const auto r = test::run_command(fmt::format(
-        "{} -3 -nt 1 -order 2{} -setnumber Mesh.MeshSizeFromCurvature 12 -setnumber Mesh.MeshSizeMax {} '{}' -o '{}' "
-        "-format msh41",
-        CM_GMSH_EXECUTABLE, gmsh_unit_option(model.units()), h, input, out));
-    if (r.exit_code == 0 && std::filesystem::exists(out)) return out;
-  }
-  return "";
-}
-
 // Classifies Gmsh's mesh at orders 2 and 1 and checks the boundary. Where the
 // regions were meshed each on its own (Gmsh without Coherence), the faces
 // they share are reported as not conforming, and nothing else.
@@ -416,19 +392,19 @@ void check_gmsh_mesh(const std::string& name, const std::string& path, double h,
 class GmshMesh : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(GmshMesh, ClassifiedBoundaryPassesTheCheck) {
-  if (!have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
+  if (!test::have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
   const std::string file = models_dir() + "/" + GetParam();
   if (!std::filesystem::exists(file)) GTEST_SKIP() << "no shared model " << file;
   const auto model = geom_occ::load_model(file);
   const std::string dir = test::make_temp_dir("classify_gmsh");
   double h = 0;
-  std::string path = gmsh_mesh(file, *model, dir, h);
+  std::string path = test::gmsh_order2_mesh(file, *model, dir, h);
   ASSERT_FALSE(path.empty()) << "gmsh failed to mesh " << file;
   check_gmsh_mesh(GetParam(), path, h, *model, model->count(3) == 1);
   if (model->count(3) > 1) {
     // What a user wanting one conforming mesh of several solids runs.
     std::ofstream(dir + "/coherent.geo") << "SetFactory(\"OpenCASCADE\");\nMerge \"" << file << "\";\nCoherence;\n";
-    path = gmsh_mesh(dir + "/coherent.geo", *model, dir, h);
+    path = test::gmsh_order2_mesh(dir + "/coherent.geo", *model, dir, h);
     ASSERT_FALSE(path.empty()) << "gmsh failed to mesh " << file << " with Coherence";
     check_gmsh_mesh(std::string(GetParam()) + " with Coherence", path, h, *model, true);
   }
@@ -491,7 +467,7 @@ TEST(ClassifyOnModel, MeshInOtherUnitsNamesTheScale) {
 }
 
 TEST(ClassifyOnModel, GmshMeshOfAnotherShapeIsOneClearError) {
-  if (!have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
+  if (!test::have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
   const std::string t20 = models_dir() + "/t20_data.step", zyl = models_dir() + "/Zylkopf.stp";
   if (!std::filesystem::exists(t20) || !std::filesystem::exists(zyl)) GTEST_SKIP() << "no shared models";
   const auto model = geom_occ::load_model(zyl);
@@ -508,7 +484,7 @@ TEST(ClassifyOnModel, GmshMeshWithItsSeamElsewhere) {
   // axis: Gmsh's seam and circle vertices are not the model's. Its vertices
   // there go on the model's face and circles, and what the mesh lacks (a
   // mesh of the model's seam, vertices at the model's vertices) is reported.
-  if (!have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
+  if (!test::have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
   const std::string dir = test::make_temp_dir("classify_seam");
   std::ofstream(dir + "/cylinder.geo") << "SetFactory(\"OpenCASCADE\");\nCylinder(1) = {0, 0, 0, 0, 0, 2, 1};\n"
                                           "Rotate {{0, 0, 1}, {0, 0, 0}, Pi/3} { Volume{1}; }\n";
@@ -535,7 +511,7 @@ TEST(ClassifyOnModel, GmshMeshWithItsSeamElsewhere) {
 // --- the optimize command ------------------------------------------------------
 
 TEST(ClassifyOnModel, OptimizeGmshMeshWithModel) {
-  if (!have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
+  if (!test::have_gmsh()) GTEST_SKIP() << "gmsh is not on PATH";
   const std::string file = models_dir() + "/Zylkopf.stp";
   if (!std::filesystem::exists(file)) GTEST_SKIP() << "no shared model " << file;
   const std::string dir = test::make_temp_dir("classify_optimize");

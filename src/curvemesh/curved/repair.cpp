@@ -315,17 +315,30 @@ void Repairer::after_edit(std::span<const TetId> created) {
     if (std::find(seen.begin(), seen.end(), k) != seen.end()) continue;
     seen.push_back(k);
     const TetId t = find_tet_with(a, b);
-    if (t == kNone)
+    if (t == kNone) {
       m_.high_order.erase_edge(a, b);
-    else
-      refresh_edge(a, b, t);
+      continue;
+    }
+    // Kept by tets outside the cavity, its nodes may change with its
+    // classification (a collapse merging model-edge segments): those tets
+    // are checked again too.
+    refresh_edge(a, b, t);
+    const mesh::Shell shell = mesh::collect_shell(m_, a, b, t);
+    created_.insert(created_.end(), shell.tets.begin(), shell.tets.end());
   }
   if (order_ >= 3) {
     for (TetId t : created) {
       const auto& v = m_.tet2verts[t];
       for (const auto& f : mesh::kFaceVerts) refresh_face(v[f[0]], v[f[1]], v[f[2]]);
     }
-    for (const auto& f : old_faces_) refresh_face(f[0], f[1], f[2]);
+    for (const auto& f : old_faces_) {
+      refresh_face(f[0], f[1], f[2]);
+      // A face kept by a tet outside the cavity: that tet is checked again.
+      if (boundary_.find_tri(f[0], f[1], f[2]) == kNone) continue;
+      if (const TetId t = find_tet_with(f[0], f[1]); t != kNone)
+        for (TetId s : mesh::collect_shell(m_, f[0], f[1], t).tets)
+          if (mesh::local_index(m_, s, f[2]) >= 0) created_.push_back(s);
+    }
   }
   old_edges_.clear();
   old_faces_.clear();
