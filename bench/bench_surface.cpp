@@ -51,8 +51,6 @@ void measure(const cm::mesh::TetMesh& m, Row& r) {
 
 // Gmsh gets this long per model (it can spend many minutes on sliver faces).
 constexpr int kGmshSeconds = 300;
-// Counts within this relative difference are comparable.
-constexpr double kMatch = 0.15;
 
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -112,16 +110,9 @@ int main() {
     // within 15% of ours, to compare speed and quality at a like count.
     Row matched;
     double factor = 1;
-    if (have_gmsh) {
-      theirs = run_gmsh(1);
-      matched = theirs;
-      for (int attempt = 0; attempt < 4 && matched.ok && matched.triangles > 0; ++attempt) {
-        const double ratio = static_cast<double>(matched.triangles) / static_cast<double>(ours.triangles);
-        if (std::abs(ratio - 1) <= kMatch) break;
-        factor *= std::sqrt(ratio);
-        matched = run_gmsh(factor);
-      }
-    }
+    if (have_gmsh)
+      std::tie(theirs, matched, factor) = cm::bench::run_matched<Row>(
+          run_gmsh, [](const Row& r) { return r.triangles; }, ours.triangles, 2);
     fmt::print("{:<36} {:>9} {:>8.3f} {:>6.3f} {:>6.3f} | ", f.filename().string(), ours.triangles, ours.seconds,
                ours.min_q, ours.mean_q);
     if (theirs.ok)
@@ -130,7 +121,7 @@ int main() {
     else
       fmt::print("{:>33} | {:>7} | ",
                  !have_gmsh ? "no gmsh" : theirs.seconds >= kGmshSeconds ? "gmsh timed out" : "gmsh failed", "");
-    if (matched.ok && std::abs(double(matched.triangles) / double(ours.triangles) - 1) <= kMatch)
+    if (matched.ok && std::abs(double(matched.triangles) / double(ours.triangles) - 1) <= cm::bench::kMatchedCount)
       fmt::print("{:>6.3f} {:>9} {:>8.3f} {:>6.3f} {:>6.3f} | {:>7.2f}\n", factor, matched.triangles, matched.seconds,
                  matched.min_q, matched.mean_q, matched.seconds / ours.seconds);
     else

@@ -66,8 +66,6 @@ void measure(const cm::mesh::TetMesh& m, Row& r) {
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 constexpr int kGmshSeconds = 600;
-// Counts within this relative difference are comparable (issue 6: ±15%).
-constexpr double kMatch = 0.15;
 
 // Runs `work` in a child process; returns its exit status and peak RSS.
 template <class F>
@@ -173,16 +171,9 @@ int main(int argc, char** argv) {
     // of ours, found by scaling Gmsh's sizes (a few tries).
     Row matched;
     double factor = 1;
-    if (have_gmsh) {
-      theirs = run_gmsh(1);
-      matched = theirs;
-      for (int attempt = 0; attempt < 4 && matched.ok && matched.tets > 0; ++attempt) {
-        const double ratio = static_cast<double>(matched.tets) / static_cast<double>(ours.tets);
-        if (std::abs(ratio - 1) <= kMatch) break;
-        factor *= std::cbrt(ratio);
-        matched = run_gmsh(factor);
-      }
-    }
+    if (have_gmsh)
+      std::tie(theirs, matched, factor) =
+          cm::bench::run_matched<Row>(run_gmsh, [](const Row& r) { return r.tets; }, ours.tets, 3);
     auto bpt = [](const Row& r) { return r.tets ? static_cast<double>(r.peak_rss) / static_cast<double>(r.tets) : 0; };
     fmt::print("{:<36} {:>9} {:>7.2f} {:>5.1f} {:>6.0f} {:>6.3f} {:>6.3f} {:>6.2f} | ", f.filename().string(),
                ours.tets, ours.seconds, 100 * ours.curvature_seconds / ours.seconds, bpt(ours), ours.min_q,
@@ -193,7 +184,7 @@ int main(int argc, char** argv) {
                  bpt(theirs), theirs.min_q, theirs.mean_q, theirs.min_dihedral, theirs.seconds / ours.seconds);
     else
       fmt::print("{:>46} | {:>7} | ", failure, "");
-    const bool close = matched.ok && std::abs(double(matched.tets) / double(ours.tets) - 1) <= kMatch;
+    const bool close = matched.ok && std::abs(double(matched.tets) / double(ours.tets) - 1) <= cm::bench::kMatchedCount;
     if (close)
       fmt::print("{:>6.3f} {:>9} {:>7.2f} {:>6.3f} {:>6.2f} | {:>7.2f}", factor, matched.tets, matched.seconds,
                  matched.min_q, matched.min_dihedral, matched.seconds / ours.seconds);

@@ -2,6 +2,8 @@
 // Where the benchmarks find the shared CAD models: $CM_MODELS_DIR, by default
 // ../../shared/models next to this source file (../shared beside the project).
 #include <algorithm>
+#include <cmath>
+#include <tuple>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -38,6 +40,26 @@ inline std::string gmsh_unit_option(const std::string& units) {
   for (const auto& [ours, occ] : kNames)
     if (units == ours) return std::string(" -setstring Geometry.OCCTargetUnit ") + occ;
   return {};
+}
+
+/// Counts within this relative difference are comparable (issue 6: ±15%).
+inline constexpr double kMatchedCount = 0.15;
+
+/// Runs Gmsh (`run(factor)`, its sizes scaled by Mesh.MeshSizeFactor) at
+/// factor 1, then rescales until its element count (`count(row)`) is within
+/// kMatchedCount of `ours`, a few tries at most: element counts go as
+/// 1/size^dim. Returns the first run and the last, with the factor used.
+template <class Row, class Run, class Count>
+std::tuple<Row, Row, double> run_matched(Run&& run, Count&& count, std::size_t ours, int dim) {
+  Row first = run(1.0), matched = first;
+  double factor = 1;
+  for (int attempt = 0; attempt < 4 && matched.ok && count(matched) > 0 && ours > 0; ++attempt) {
+    const double ratio = static_cast<double>(count(matched)) / static_cast<double>(ours);
+    if (std::abs(ratio - 1) <= kMatchedCount) break;
+    factor *= std::pow(ratio, 1.0 / dim);
+    matched = run(factor);
+  }
+  return {first, matched, factor};
 }
 
 }  // namespace cm::bench

@@ -3,12 +3,15 @@
 // mesher on built-in shapes and shared models. `alpha` sets how coarse the
 // curvature sizing is: 0.25 leaves edges spanning up to ~90° of a small
 // hole, where curving makes many tets invalid (what the repair is for).
+#include <algorithm>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "curvemesh/curved/curve.hpp"
 #include "curvemesh/generate/volume_mesh.hpp"
 #include "curvemesh/geom_occ/load.hpp"
+#include "curvemesh/mesh/topology.hpp"
 #include "curvemesh/optimize/improve.hpp"
 #include "curvemesh/size/build.hpp"
 
@@ -37,6 +40,17 @@ inline Meshed mesh_for_curving(const std::string& spec, double alpha, double hma
   io.model = r.model.get();
   optimize::improve_quality(r.m, io);
   return r;
+}
+
+/// Boundary edges of m (edges of its triangles and its classified edges),
+/// each as (smaller id, larger id).
+inline std::set<std::pair<VertId, VertId>> boundary_edges(const mesh::TetMesh& m) {
+  std::set<std::pair<VertId, VertId>> out;
+  auto add = [&](VertId a, VertId b) { out.insert({std::min(a, b), std::max(a, b)}); };
+  for (const auto& t : m.tris)
+    for (const auto& e : mesh::kTriEdges) add(t.verts[e[0]], t.verts[e[1]]);
+  for (const auto& e : m.edges) add(e.verts[0], e.verts[1]);
+  return out;
 }
 
 }  // namespace cm::test

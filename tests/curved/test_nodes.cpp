@@ -14,16 +14,6 @@
 namespace cm::test {
 namespace {
 
-// Sorted boundary edges of m: the edges of its triangles and m.edges.
-std::set<std::pair<VertId, VertId>> boundary_edges(const mesh::TetMesh& m) {
-  std::set<std::pair<VertId, VertId>> out;
-  auto add = [&](VertId a, VertId b) { out.insert({std::min(a, b), std::max(a, b)}); };
-  for (const auto& t : m.tris)
-    for (const auto& e : mesh::kTriEdges) add(t.verts[e[0]], t.verts[e[1]]);
-  for (const auto& e : m.edges) add(e.verts[0], e.verts[1]);
-  return out;
-}
-
 class NodesOnShapes : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
 
 TEST_P(NodesOnShapes, EveryBoundaryNodeIsOnItsEntityAndInteriorEntitiesHaveNone) {

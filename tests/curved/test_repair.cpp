@@ -63,16 +63,6 @@ TEST(ElementCheck, EdgeBentThroughTheOppositeFaceIsInvalidThere) {
   EXPECT_FALSE(curved::check_element(2, n, strict).acceptable);
 }
 
-// Boundary edges of m (edges of its triangles and its classified edges).
-std::set<std::pair<VertId, VertId>> boundary_edges(const mesh::TetMesh& m) {
-  std::set<std::pair<VertId, VertId>> out;
-  auto add = [&](VertId a, VertId b) { out.insert({std::min(a, b), std::max(a, b)}); };
-  for (const auto& t : m.tris)
-    for (const auto& e : mesh::kTriEdges) add(t.verts[e[0]], t.verts[e[1]]);
-  for (const auto& e : m.edges) add(e.verts[0], e.verts[1]);
-  return out;
-}
-
 struct Case {
   const char* name;
   const char* spec;

@@ -12,21 +12,10 @@ namespace cm::modify {
 
 namespace {
 
-std::array<VertId, 3> face_of(const std::array<VertId, 4>& tv, int f) {
-  const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
-  return {tv[fv[0]], tv[fv[1]], tv[fv[2]]};
-}
-
-bool same_cycle(const std::array<VertId, 3>& x, const std::array<VertId, 3>& y) {
-  for (int k = 0; k < 3; ++k)
-    if (x[0] == y[k] && x[1] == y[(k + 1) % 3] && x[2] == y[(k + 2) % 3]) return true;
-  return false;
-}
-
 // The face of `tv` on these three vertices, in the tet's (outward) order.
 std::array<VertId, 3> oriented_face(const std::array<VertId, 4>& tv, VertId x, VertId y, VertId z) {
   for (int f = 0; f < 4; ++f)
-    if (tv[f] != x && tv[f] != y && tv[f] != z) return face_of(tv, f);
+    if (tv[f] != x && tv[f] != y && tv[f] != z) return tet_face(tv, f);
   return {x, y, z};
 }
 

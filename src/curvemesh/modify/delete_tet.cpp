@@ -12,17 +12,7 @@ namespace cm::modify {
 
 namespace {
 
-std::array<VertId, 3> face_of(const mesh::TetMesh& m, TetId t, int f) {
-  const auto& tv = m.tet2verts[t];
-  const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
-  return {tv[fv[0]], tv[fv[1]], tv[fv[2]]};
-}
-
-bool same_cycle(const std::array<VertId, 3>& x, const std::array<VertId, 3>& y) {
-  for (int k = 0; k < 3; ++k)
-    if (x[0] == y[k] && x[1] == y[(k + 1) % 3] && x[2] == y[(k + 2) % 3]) return true;
-  return false;
-}
+std::array<VertId, 3> face_of(const mesh::TetMesh& m, TetId t, int f) { return tet_face(m.tet2verts[t], f); }
 
 Vec3 centroid(const mesh::TetMesh& m, const std::array<VertId, 3>& v) {
   return (m.coords[v[0]] + m.coords[v[1]] + m.coords[v[2]]) / 3;

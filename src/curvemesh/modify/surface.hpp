@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "curvemesh/geom/model.hpp"
+#include "curvemesh/mesh/topology.hpp"
 #include "curvemesh/modify/cavity.hpp"
 
 namespace cm::modify {
@@ -99,6 +100,21 @@ std::optional<Vec2> param_on_face(const mesh::TetMesh& m, const geom::Model* mod
 /// projection of a coarse triangle's centroid depends on the hint.
 std::optional<Vec2> check_hint(const mesh::TetMesh& m, const std::array<VertId, 3>& verts, int face,
                                VertId moved = kNone, std::optional<Vec2> moved_param = {});
+
+/// Face f of a tet with vertices tv, in the order of mesh::kFaceVerts
+/// (its normal out of the tet).
+inline std::array<VertId, 3> tet_face(const std::array<VertId, 4>& tv, int f) {
+  const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
+  return {tv[fv[0]], tv[fv[1]], tv[fv[2]]};
+}
+
+/// Whether two triangles on the same vertices list them in the same cyclic
+/// order (the same orientation).
+inline bool same_cycle(const std::array<VertId, 3>& x, const std::array<VertId, 3>& y) {
+  for (int k = 0; k < 3; ++k)
+    if (x[0] == y[k] && x[1] == y[(k + 1) % 3] && x[2] == y[(k + 2) % 3]) return true;
+  return false;
+}
 
 /// Unnormalized normal of triangle (a, b, c) (right-hand rule).
 inline Vec3 tri_normal(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a); }
