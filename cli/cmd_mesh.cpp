@@ -210,7 +210,13 @@ int run_volume(const MeshCliOptions& o) {
   j["optimization"] = {{"edge_removals", opt.edge_removals},
                        {"face_swaps", opt.face_swaps},
                        {"relocations", opt.relocations},
+                       {"boundary_relocations", opt.boundary_relocations},
+                       {"searched_relocations", opt.searched_relocations},
+                       {"insertions", opt.insertions},
+                       {"deletions", opt.deletions},
+                       {"collapses", opt.collapses},
                        {"passes", opt.passes},
+                       {"min_dihedral_before", opt.min_dihedral_before},
                        {"mean_ratio_min_before", opt.min_before},
                        {"below_0_3_before", opt.below_before},
                        {"below_0_3_after", opt.below_after}};
@@ -243,10 +249,12 @@ int run_volume(const MeshCliOptions& o) {
                st.recovery.steiner_on_edges, st.recovery.steiner_on_faces, st.recovery.surface_flips,
                st.recovery.rounds);
     if (!o.no_optimize)
-      fmt::print("optimization: {} edge removals, {} face swaps, {} relocations in {} passes; tets with mean ratio "
-                 "< 0.3: {} -> {}; min {:.3f} -> {:.3f}\n",
-                 opt.edge_removals, opt.face_swaps, opt.relocations, opt.passes, opt.below_before, opt.below_after,
-                 opt.min_before, opt.min_after);
+      fmt::print("optimization: {} edge removals, {} face swaps, {} relocations ({} searched), {} insertions, {} "
+                 "deletions, {} collapses in {} passes; tets with mean ratio < 0.3: {} -> {}; min {:.3f} -> {:.3f}; "
+                 "min dihedral {:.2f} -> {:.2f} deg\n",
+                 opt.edge_removals, opt.face_swaps, opt.relocations, opt.searched_relocations, opt.insertions,
+                 opt.deletions, opt.collapses, opt.passes, opt.below_before, opt.below_after, opt.min_before,
+                 opt.min_after, opt.min_dihedral_before, opt.min_dihedral_after);
     fmt::print("quality: mean ratio min {:.3f} mean {:.3f}; min dihedral {:.2f} deg\n", qs.min, qs.mean, ds.min);
     fmt::print("volume: mesh {:.6g}, model {:.6g} (relative difference {:.2e})\n", vol_mesh, vol_model,
                vol_model > 0 ? (vol_mesh - vol_model) / vol_model : 0.0);

@@ -105,4 +105,34 @@ std::vector<TetId> MeshEditor::compact() {
   return remap;
 }
 
+std::vector<VertId> drop_unused_vertices(mesh::TetMesh& m) {
+  const std::size_t nv = m.num_verts();
+  std::vector<VertId> old2new(nv, kNone);
+  for (const auto& tv : m.tet2verts)
+    for (VertId v : tv) old2new[v] = 0;
+  VertId next = 0;
+  for (VertId v = 0; v < nv; ++v)
+    if (old2new[v] == 0) old2new[v] = next++;
+  if (next == nv) return {};
+  for (VertId v = 0; v < nv; ++v) {
+    const VertId w = old2new[v];
+    if (w == kNone) continue;
+    m.coords[w] = m.coords[v];
+    m.vert_class[w] = m.vert_class[v];
+    m.vert_param[w] = m.vert_param[v];
+    if (v < m.vert2tet.size()) m.vert2tet[w] = m.vert2tet[v];
+  }
+  m.coords.resize(next);
+  m.vert_class.resize(next);
+  m.vert_param.resize(next);
+  m.vert2tet.resize(next);
+  for (auto& tv : m.tet2verts)
+    for (VertId& v : tv) v = old2new[v];
+  for (auto& t : m.tris)
+    for (VertId& v : t.verts) v = old2new[v];
+  for (auto& e : m.edges)
+    for (VertId& v : e.verts) v = old2new[v];
+  return old2new;
+}
+
 }  // namespace cm::modify

@@ -134,4 +134,11 @@ class MeshEditor {
   RebuildHook hook_;
 };
 
+/// Drops the vertices no tet uses (those collapses and element deletions
+/// left behind): renumbers tets, m.tris, m.edges and the per-vertex arrays,
+/// keeping the order of the rest. Precondition: no dead tets (compact()
+/// first) and no high-order nodes. Returns old id -> new id (kNone for a
+/// dropped vertex), empty when none was dropped. O(V + T).
+std::vector<VertId> drop_unused_vertices(mesh::TetMesh& m);
+
 }  // namespace cm::modify

@@ -12,6 +12,7 @@
 // every new tet strictly positive by exact orient3d (the measure must
 // return a value <= 0 for a tet that is not).
 #include <array>
+#include <utility>
 
 #include "curvemesh/modify/swap.hpp"
 
@@ -29,6 +30,14 @@ using TetMeasure = double (*)(const mesh::TetMesh& m, const std::array<VertId, 4
 double angle_aware_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 /// angle_aware_quality of mesh vertices, as a TetMeasure (context unused).
 double angle_aware_measure(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void* context);
+
+/// The floor of is_progress (both measures).
+inline constexpr double kProgressFloor = 0.2;
+
+/// Mean ratio and angle_aware_quality of one tet (both -1 unless strictly
+/// positive by exact orient3d), for searches that must keep the first
+/// above a floor while raising the second.
+std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
 /// Whether replacing tets whose worst mean ratio and worst angle-aware
 /// quality are (mr_before, shape_before) by tets with (mr_after,

@@ -7,6 +7,7 @@
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/modify/surface.hpp"
 #include "curvemesh/optimize/measured_swap.hpp"
+#include "curvemesh/optimize/vertex_search.hpp"
 
 namespace cm::optimize {
 
@@ -67,6 +68,15 @@ void place_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> fac
       if (!(qy.second > q.second)) break;
       x = y;
       q = qy;
+    }
+    // Smoothing finds the middle of a fair cavity; a flat one (a sliver's
+    // four boundary vertices) needs the point where its worst tet is best.
+    if (q.second > 0) {
+      const Vec3 y = search_star_point(m, faces, x, std::min(before.first, kProgressFloor));
+      if (const auto qy = star_quality(m, faces, y); qy.second > q.second) {
+        x = y;
+        q = qy;
+      }
     }
     positive |= q.second > 0;
     if (q.second > plan.after && is_progress(before.first, before.second, q.first, q.second)) {
