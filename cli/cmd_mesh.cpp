@@ -157,6 +157,8 @@ int run_volume(const MeshCliOptions& o) {
     // fresh mesh are mostly against the boundary, pinned there otherwise.
     optimize::ImproveOptions io;
     io.model = model;
+    // Deletions move the surface: within the chord rule the sizes asked for.
+    if (so.curvature.kind == size::CurvatureRule::Kind::kRelativeDeviation) io.chord_alpha = so.curvature.value;
     opt = optimize::improve_quality(m, io);
   }
   step.reset();

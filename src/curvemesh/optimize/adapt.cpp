@@ -153,12 +153,13 @@ void refresh(MetricField& f, const AdaptOptions& o, const mesh::TetMesh& m, Vert
 // A tet on two or three faces of one model face goes (with a model) when it
 // is worse in the metric than every tet across its inner faces.
 bool delete_in_metric(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryIndex& boundary,
-                      const geom::Model* model, const MetricField& f, TetId t) {
+                      const AdaptOptions& o, const MetricField& f, TetId t) {
   const auto& m = ed.mesh();
   int hull = 0;
   for (int i = 0; i < 4; ++i) hull += m.tet2adj[mesh::pack_face(t, i)] == kNone;
-  if (!model || hull < 2 || hull == 4) return false;
-  const modify::TetDeletion plan = modify::plan_tet_deletion(ed, cav, boundary, t, model);
+  if (!o.model || hull < 2 || hull == 4) return false;
+  const modify::TetDeletion plan =
+      modify::plan_tet_deletion(ed, cav, boundary, t, o.model, modify::DeletionOptions{o.chord_alpha});
   if (plan.refusal != modify::Refusal::kNone) return false;
   double across = 1;
   for (int i = 0; i < 4; ++i)
@@ -390,7 +391,7 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
     std::sort(bad.begin(), bad.end());
     for (const auto& [q0, t] : bad) {
       if (ed.is_dead(t) || field.tet_quality(m, m.tet2verts[t]) >= o.threshold) continue;
-      if (o.deletion && delete_in_metric(ed, cav, boundary, o.model, field, t)) {
+      if (o.deletion && delete_in_metric(ed, cav, boundary, o, field, t)) {
         ++st.deletions;
         ++changes;
         continue;

@@ -55,8 +55,10 @@ struct AdaptOptions {
   /// Shell point insertion (shell_insert.hpp) for tets nothing else
   /// improves; isotropic fields only.
   bool insertion = true;
-  /// Element deletion of poor tets on the boundary (with a model only).
+  /// Element deletion of poor tets on the boundary (with a model only), and
+  /// the chord rule it keeps (modify::DeletionOptions).
   bool deletion = true;
+  double chord_alpha = 0.04;
   /// The CAD model the mesh is classified on, or nullptr (boundary kept).
   const geom::Model* model = nullptr;
   /// The analytic size or metric the field was sampled from, or nullptr.

@@ -151,12 +151,13 @@ bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::Bou
 // A tet on two or three faces of one model face goes when it is worse than
 // the tets across its inner faces (they are what remains there).
 bool try_delete(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryIndex& boundary,
-                const geom::Model* model, TetId t, ImproveStats& st, std::vector<TetId>& touched) {
+                const ImproveOptions& o, TetId t, ImproveStats& st, std::vector<TetId>& touched) {
   const auto& m = ed.mesh();
   int hull = 0;
   for (int f = 0; f < 4; ++f) hull += m.tet2adj[mesh::pack_face(t, f)] == kNone;
   if (hull < 2 || hull == 4) return false;
-  const modify::TetDeletion plan = modify::plan_tet_deletion(ed, cav, boundary, t, model);
+  const modify::TetDeletion plan =
+      modify::plan_tet_deletion(ed, cav, boundary, t, o.model, modify::DeletionOptions{o.chord_alpha});
   if (plan.refusal != modify::Refusal::kNone) return false;
   std::pair<double, double> across{1, 1}, self{1, 1};
   for (int f = 0; f < 4; ++f)
@@ -297,7 +298,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
       if (ed.is_dead(t) || !needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o)) continue;
       if (o.deletion && o.model) {
         Timer op;
-        const bool done = try_delete(ed, cav, *boundary, o.model, t, st, touched);
+        const bool done = try_delete(ed, cav, *boundary, o, t, st, touched);
         st.deletion_seconds += op.seconds();
         if (done) {
           ++changes;

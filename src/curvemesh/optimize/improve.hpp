@@ -40,8 +40,11 @@ struct ImproveOptions {
   /// Relocation by search when the Laplacian move does not help.
   bool search = true;
   bool insertion = true;
-  /// Element deletion (with a model only).
+  /// Element deletion (with a model only), and the chord rule it keeps the
+  /// new boundary to (modify::DeletionOptions: the mesher's relative
+  /// deviation, --curv-alpha).
   bool deletion = true;
+  double chord_alpha = 0.04;
   /// Edge collapse of a poor tet's edges (boundary vertices with a model
   /// only, along their entity).
   bool collapse = true;
