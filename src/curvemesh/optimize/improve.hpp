@@ -33,8 +33,12 @@ struct ImproveOptions {
   /// Tets with mean ratio below this are worked on (0.3 ≈ min dihedral 10°
   /// for a typical sliver).
   double threshold = 0.3;
-  /// Tets with a dihedral angle below this (degrees) are worked on too.
-  double dihedral_threshold = 12.0;
+  /// Tets with a dihedral angle below this (degrees) are worked on too, and
+  /// the relocation search raises angles up to it. Well above the 10° most
+  /// solvers ask for: on the shared models 18 gives minima of 15-18° and
+  /// mean ratios of 0.35-0.45 where 12 gave 12° and 0.30, for about 1.5x
+  /// the time.
+  double dihedral_threshold = 18.0;
   bool swaps = true;
   bool relocation = true;
   /// Relocation by search when the Laplacian move does not help.
