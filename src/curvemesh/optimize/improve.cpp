@@ -180,8 +180,8 @@ bool try_delete(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryInd
 // edge or face only with the model (the collapse's own rules), so a thin
 // triangle at a sharp corner of a face can lengthen until it is no longer
 // thin.
-bool try_collapse(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryIndex* boundary,
-                  const geom::Model* model, TetId t, ImproveStats& st, std::vector<TetId>& ball) {
+bool try_collapse(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryIndex& boundary,
+                  const geom::Model* model, TetId t, ImproveStats& st) {
   auto& m = ed.mesh();
   const auto tv = m.tet2verts[t];
   int best = -1;
@@ -190,8 +190,7 @@ bool try_collapse(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryI
     const auto& e = mesh::kTetEdges[static_cast<std::size_t>(k % 6)];
     const VertId from = tv[static_cast<std::size_t>(k < 6 ? e[0] : e[1])], to = tv[static_cast<std::size_t>(k < 6 ? e[1] : e[0])];
     if (m.vert_class[from].dim != 3 && !model) continue;
-    if (!boundary) continue;
-    const auto plan = modify::plan_collapse(ed, cav, *boundary, from, to, model);
+    const auto plan = modify::plan_collapse(ed, cav, boundary, from, to, model);
     if (plan.refusal != modify::Refusal::kNone) continue;
     const auto before = worst_of(m, cav.tets());
     std::pair<double, double> after{1, 1};
@@ -207,12 +206,11 @@ bool try_collapse(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryI
     best = k;
     best_after = after;
   }
-  (void)ball;
   if (best < 0) return false;
   const auto& e = mesh::kTetEdges[static_cast<std::size_t>(best % 6)];
   const VertId from = tv[static_cast<std::size_t>(best < 6 ? e[0] : e[1])], to = tv[static_cast<std::size_t>(best < 6 ? e[1] : e[0])];
-  const auto plan = modify::plan_collapse(ed, cav, *boundary, from, to, model);
-  modify::apply(ed, cav, *boundary, plan);
+  const auto plan = modify::plan_collapse(ed, cav, boundary, from, to, model);
+  modify::apply(ed, cav, boundary, plan);
   ++st.collapses;
   return true;
 }
@@ -325,7 +323,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
       }
       if (o.collapse && stuck) {
         Timer op;
-        const bool done = try_collapse(ed, cav, boundary.get(), o.model, t, st, ball);
+        const bool done = try_collapse(ed, cav, *boundary, o.model, t, st);
         st.collapse_seconds += op.seconds();
         if (done) {
           ++changes;

@@ -6,10 +6,11 @@
 // faces (the best improving reconnection wins, ranked by the mean ratio
 // capped by the smallest dihedral angle: measured_swap.hpp), then relocation
 // of its vertices (the smart Laplacian, else a search for the position best
-// for the ball's worst tet: vertex_search.hpp), else a new interior point
-// replacing the shell of one of its interior edges (shell_insert.hpp: the
-// fix for slivers whose vertices are all on the boundary); repeated over a
-// few passes until nothing improves.
+// for the ball's worst tet: vertex_search.hpp), else the collapse of one of
+// its edges, else a new interior point replacing the shell of one of its
+// interior edges (shell_insert.hpp: the fix for slivers whose vertices are
+// all on the boundary); repeated over passes until nothing improves. The
+// search and the collapses join in once the other operators are stuck.
 // A tet is worked on when its mean ratio is below the threshold or its
 // smallest dihedral angle below the angle threshold: flat caps and slivers
 // can keep a fair mean ratio while one angle is tiny, and solvers suffer
@@ -73,9 +74,9 @@ struct ImproveStats {
 };
 
 /// Improves m in place (tets renumbered, adjacency kept; insertions append
-/// region vertices; a deletion that takes its vertex leaves it unused, and
-/// unused vertices are dropped at the end, the others keeping their order —
-/// without a model vertex ids never change). Requires a
+/// region vertices; a collapse, or a deletion that takes its vertex, leaves
+/// a vertex unused, and unused vertices are dropped at the end, the others
+/// keeping their order). Requires a
 /// valid mesh with adjacency; flat tets (zero volume) are allowed and are
 /// the first worked on. Never creates a tet that is not strictly
 /// positive (exact orient3d), and never lowers the worst mean ratio of the
