@@ -185,7 +185,7 @@ TEST(VertexSearch, FindsWhatTheLaplacianCannotAndStaysValid) {
                                      m.coords[tv[3]].data()),
                 0);
     }
-    EXPECT_GE(after.mean_ratio, std::min(before.mean_ratio, kProgressFloor));
+    EXPECT_GE(after.mean_ratio, mean_ratio_floor(before.mean_ratio, before.shape));
     EXPECT_TRUE(is_progress(before.mean_ratio, before.shape, after.mean_ratio, after.shape) ||
                 after.shape >= std::min(before.shape, 30.0 / 70.528779365509308))
         << "vertex " << v;

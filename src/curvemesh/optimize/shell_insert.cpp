@@ -89,7 +89,7 @@ void place_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> fac
   // four boundary vertices) needs the point where its worst tet is best:
   // searched for from the best smoothed point, when that is not good enough.
   if (best_q.second > 0 && best_q.second < kSearchBelow) {
-    const Vec3 y = search_star_point(m, faces, best, std::min(before.first, kProgressFloor));
+    const Vec3 y = search_star_point(m, faces, best, mean_ratio_floor(before.first, before.second));
     consider(y, star_quality(m, faces, y));
   }
   if (!positive)

@@ -91,8 +91,8 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
   mesh::collect_ball(m, v, ball);
   const Vec3 start = m.coords[v];
   // Ranks a position (see Poll), the mean ratio floor being what
-  // is_progress keeps the ball's worst at: its value now, at most
-  // kProgressFloor, so the search never leaves what the driver accepts.
+  // is_progress keeps the ball's worst at (mean_ratio_floor of its worst
+  // now), so the search never leaves what the driver accepts.
   const double goal = angle_goal / kRegularDihedral;
   double floor = -1;
   auto rank_at = [&](Poll& p) {
@@ -106,7 +106,7 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
       if (shape <= 0 || mr < floor) break;
     }
     m.coords[v] = start;
-    if (floor < 0) floor = std::min(mr, kProgressFloor);  // the first call: at the start
+    if (floor < 0) floor = mean_ratio_floor(mr, shape);  // the first call: at the start
     const bool ok = shape > 0 && mr >= floor;
     p.score = ok ? std::min(shape, goal) : -1;
     p.tie = ok ? mr : -1;

@@ -28,8 +28,8 @@ namespace cm::optimize {
 
 /// Plans moving v by the search. Fills the cavity with v's ball; changes
 /// nothing (coordinates are restored after each poll). Only positions where
-/// the ball's worst mean ratio stays at or above the lower of its value now
-/// and kProgressFloor are considered (what is_progress accepts); among
+/// the ball's worst mean ratio stays at or above mean_ratio_floor of its
+/// worst now (what is_progress accepts) are considered; among
 /// them the search raises the ball's worst angle-aware quality up to that
 /// of a tet whose smallest dihedral angle is `angle_goal` degrees, then
 /// (the angles being good enough) the worst mean ratio. Refusals: those of
