@@ -159,6 +159,8 @@ int run_volume(const MeshCliOptions& o) {
     // fresh mesh are mostly against the boundary, pinned there otherwise.
     optimize::ImproveOptions io;
     io.model = model;
+    // Deletions move the surface: within the chord rule the sizes asked for.
+    if (so.curvature.kind == size::CurvatureRule::Kind::kRelativeDeviation) io.chord_alpha = so.curvature.value;
     opt = optimize::improve_quality(m, io);
   }
   std::optional<curved::CurveReport> curving;
@@ -220,7 +222,13 @@ int run_volume(const MeshCliOptions& o) {
   j["optimization"] = {{"edge_removals", opt.edge_removals},
                        {"face_swaps", opt.face_swaps},
                        {"relocations", opt.relocations},
+                       {"boundary_relocations", opt.boundary_relocations},
+                       {"searched_relocations", opt.searched_relocations},
+                       {"insertions", opt.insertions},
+                       {"deletions", opt.deletions},
+                       {"collapses", opt.collapses},
                        {"passes", opt.passes},
+                       {"min_dihedral_before", opt.min_dihedral_before},
                        {"mean_ratio_min_before", opt.min_before},
                        {"below_0_3_before", opt.below_before},
                        {"below_0_3_after", opt.below_after}};
@@ -255,10 +263,12 @@ int run_volume(const MeshCliOptions& o) {
                st.recovery.steiner_on_edges, st.recovery.steiner_on_faces, st.recovery.surface_flips,
                st.recovery.rounds);
     if (!o.no_optimize)
-      fmt::print("optimization: {} edge removals, {} face swaps, {} relocations in {} passes; tets with mean ratio "
-                 "< 0.3: {} -> {}; min {:.3f} -> {:.3f}\n",
-                 opt.edge_removals, opt.face_swaps, opt.relocations, opt.passes, opt.below_before, opt.below_after,
-                 opt.min_before, opt.min_after);
+      fmt::print("optimization: {} edge removals, {} face swaps, {} relocations ({} searched), {} insertions, {} "
+                 "deletions, {} collapses in {} passes; tets with mean ratio < 0.3: {} -> {}; min {:.3f} -> {:.3f}; "
+                 "min dihedral {:.2f} -> {:.2f} deg\n",
+                 opt.edge_removals, opt.face_swaps, opt.relocations, opt.searched_relocations, opt.insertions,
+                 opt.deletions, opt.collapses, opt.passes, opt.below_before, opt.below_after, opt.min_before,
+                 opt.min_after, opt.min_dihedral_before, opt.min_dihedral_after);
     if (curving) print_curve_report(*curving);
     fmt::print("quality{}: mean ratio min {:.3f} mean {:.3f}; min dihedral {:.2f} deg\n",
                curving ? " (straight-sided)" : "", qs.min, qs.mean, ds.min);

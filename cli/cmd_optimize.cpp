@@ -247,8 +247,9 @@ std::string render_lengths(const optimize::LengthStats& l) {
 std::string boundary_policy(bool adapt, bool model) {
   if (!model) return adapt ? "kept (boundary vertices fixed; boundary edges split at their midpoints)"
                            : "kept (boundary vertices and triangles unchanged)";
-  return adapt ? "on the model (boundary vertices moved, split onto and collapsed along it)"
-               : "on the model (boundary vertices moved on their model face or edge)";
+  return adapt ? "on the model (boundary vertices moved, split onto and collapsed along it; poor tets on it deleted)"
+               : "on the model (boundary vertices moved on their model face or edge, collapsed along it; poor tets "
+                 "on it deleted)";
 }
 
 int run_optimize(const OptimizeCliOptions& o) {
@@ -368,6 +369,7 @@ int run_optimize(const OptimizeCliOptions& o) {
                       {"splits", adapt.splits},
                       {"collapses", adapt.collapses},
                       {"insertions", adapt.insertions},
+                      {"deletions", adapt.deletions},
                       {"passes", adapt.passes},
                       {"seconds",
                        {{"splits", adapt.split_seconds},
@@ -383,12 +385,17 @@ int run_optimize(const OptimizeCliOptions& o) {
                       {"face_swaps", iso.face_swaps},
                       {"relocations", iso.relocations},
                       {"boundary_relocations", iso.boundary_relocations},
+                      {"searched_relocations", iso.searched_relocations},
                       {"insertions", iso.insertions},
+                      {"deletions", iso.deletions},
+                      {"collapses", iso.collapses},
                       {"passes", iso.passes},
                       {"seconds",
                        {{"swaps", iso.swap_seconds},
                         {"relocation", iso.relocation_seconds},
-                        {"insertion", iso.insertion_seconds}}}};
+                        {"insertion", iso.insertion_seconds},
+                        {"deletion", iso.deletion_seconds},
+                        {"collapse", iso.collapse_seconds}}}};
     op_seconds = iso.seconds;
   }
   if (classified) j["classification"] = classification_json(*classified);
@@ -413,10 +420,10 @@ int run_optimize(const OptimizeCliOptions& o) {
     line("after", after);
     if (metric) {
       fmt::print("operators: {} splits, {} collapses, {} edge removals, {} face swaps, {} relocations, {} "
-                 "insertions in {} passes (splits {:.2f} s, collapses {:.2f} s, swaps {:.2f} s, relocation {:.2f} "
-                 "s, insertion {:.2f} s)\n",
+                 "insertions, {} deletions in {} passes (splits {:.2f} s, collapses {:.2f} s, swaps {:.2f} s, "
+                 "relocation {:.2f} s, insertion {:.2f} s)\n",
                  adapt.splits, adapt.collapses, adapt.edge_removals, adapt.face_swaps, adapt.relocations,
-                 adapt.insertions, adapt.passes, adapt.split_seconds, adapt.collapse_seconds, adapt.swap_seconds,
+                 adapt.insertions, adapt.deletions, adapt.passes, adapt.split_seconds, adapt.collapse_seconds, adapt.swap_seconds,
                  adapt.relocation_seconds, adapt.insertion_seconds);
       fmt::print("lengths in the metric: {:.1f}% of {} edges in [0.7, 1.4] before, {:.1f}% after (min {:.3f} max "
                  "{:.3f} mean {:.3f})\n",
@@ -425,10 +432,12 @@ int run_optimize(const OptimizeCliOptions& o) {
                  adapt.lengths_after.mean);
       fmt::print("{}", render_lengths(adapt.lengths_after));
     } else {
-      fmt::print("operators: {} edge removals, {} face swaps, {} relocations ({} on the boundary), {} insertions in {} passes (swaps "
-                 "{:.2f} s, relocation {:.2f} s, insertion {:.2f} s)\n",
-                 iso.edge_removals, iso.face_swaps, iso.relocations, iso.boundary_relocations, iso.insertions, iso.passes, iso.swap_seconds,
-                 iso.relocation_seconds, iso.insertion_seconds);
+      fmt::print("operators: {} edge removals, {} face swaps, {} relocations ({} on the boundary, {} searched), {} "
+                 "insertions, {} deletions, {} collapses in {} passes (swaps {:.2f} s, relocation {:.2f} s, insertion "
+                 "{:.2f} s, deletion {:.2f} s, collapse {:.2f} s)\n",
+                 iso.edge_removals, iso.face_swaps, iso.relocations, iso.boundary_relocations, iso.searched_relocations,
+                 iso.insertions, iso.deletions, iso.collapses, iso.passes, iso.swap_seconds, iso.relocation_seconds,
+                 iso.insertion_seconds, iso.deletion_seconds, iso.collapse_seconds);
     }
     fmt::print("{}", render_limit(limit));
     fmt::print("volume: {:.10g} -> {:.10g}; boundary: {}\n", before.volume, after.volume,

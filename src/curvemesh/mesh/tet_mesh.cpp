@@ -45,10 +45,7 @@ std::vector<VertId> drop_unused_vertices(TetMesh& m) {
   VertId next = 0;
   for (VertId v = 0; v < nv; ++v)
     if (old2new[v] != kNone) old2new[v] = next++;
-  if (next == nv) {
-    for (VertId v = 0; v < nv; ++v) old2new[v] = v;
-    return old2new;
-  }
+  if (next == nv) return {};
   const bool seeds = m.vert2tet.size() == nv;
   for (VertId v = 0; v < nv; ++v) {
     const VertId w = old2new[v];

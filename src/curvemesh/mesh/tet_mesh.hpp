@@ -98,10 +98,12 @@ struct TetMesh {
   std::size_t memory_bytes() const;
 };
 
-/// Removes the vertices no tet uses (those collapses leave), renumbering
-/// the rest in order: tets, boundary triangles and edges, the per-vertex
-/// arrays (vert2tet included, kept valid) and the high-order nodes follow.
-/// Returns old id -> new id (kNone for a removed vertex). O(V + T).
+/// Removes the vertices no tet uses (those collapses and element deletions
+/// leave), renumbering the rest in order: tets, boundary triangles and
+/// edges, the per-vertex arrays (vert2tet included, kept valid) and the
+/// high-order nodes follow. Precondition: no dead tets (an editor's
+/// compact() first). Returns old id -> new id (kNone for a removed vertex),
+/// empty when none was removed. O(V + T).
 std::vector<VertId> drop_unused_vertices(TetMesh& m);
 
 /// Packed face handle helpers for tet2adj.

@@ -199,6 +199,65 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
   return r;
 }
 
+Relocation plan_relocation_to(MeshEditor& ed, Cavity& cav, const BoundaryIndex* surf, VertId v,
+                              const geom::Model* model, const Vec3& target, const mesh::Param& param) {
+  auto& m = ed.mesh();
+  Relocation r;
+  const mesh::ModelRef c = v < m.vert_class.size() ? m.vert_class[v] : mesh::ModelRef{};
+  const bool boundary = c.dim == 1 || c.dim == 2;
+  if ((c.dim != 3 && !boundary) || m.vert2tet[v] == kNone || (boundary && (!model || !surf))) {
+    r.refusal = Refusal::kClassification;
+    return r;
+  }
+  thread_local std::vector<TetId> ball;
+  thread_local std::vector<TriBefore> tris;
+  mesh::collect_ball(m, v, ball);
+  cav.reset(ed);
+  tris.clear();
+  for (TetId t : ball) {
+    cav.add(ed, t);
+    if (!boundary) continue;
+    const auto& tv = m.tet2verts[t];
+    const int iv = mesh::local_index(m, t, v);
+    for (int f = 0; f < 4; ++f) {
+      if (f == iv) continue;
+      const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
+      const Index i = surf->find_tri(tv[fv[0]], tv[fv[1]], tv[fv[2]]);
+      if (i != kNone && std::none_of(tris.begin(), tris.end(), [i](const TriBefore& x) { return x.tri == i; }))
+        tris.push_back({i, Vec3::Zero(), false});
+    }
+  }
+  r.before = min_quality(m, ball);
+  for (TriBefore& x : tris) {
+    const auto& tv = m.tris[x.tri].verts;
+    x.normal = tri_normal(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]]);
+    const int f = m.tris[x.tri].face_tag;
+    x.agrees = agrees_with_model(*model, f, m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], check_hint(m, tv, f));
+  }
+  const Vec3 old = m.coords[v];
+  m.coords[v] = target;
+  r.after = min_quality(m, ball);
+  r.target = target;
+  if (!(r.after > 0)) r.refusal = Refusal::kNotStarShaped;
+  const std::optional<Vec2> moved_param =
+      c.dim == 2 ? std::optional<Vec2>(Vec2(param.u, param.v)) : std::optional<Vec2>();
+  for (const TriBefore& x : tris) {
+    if (r.refusal != Refusal::kNone) break;
+    const auto& tri = m.tris[x.tri];
+    const Vec3 &a = m.coords[tri.verts[0]], &b = m.coords[tri.verts[1]], &d = m.coords[tri.verts[2]];
+    if (!(tri_normal(a, b, d).dot(x.normal) > 0) ||
+        (x.agrees && !agrees_with_model(*model, tri.face_tag, a, b, d,
+                                        check_hint(m, tri.verts, tri.face_tag, v, moved_param))))
+      r.refusal = Refusal::kFoldedSurface;
+  }
+  m.coords[v] = old;
+  if (boundary) {
+    r.param.u = param.u;
+    if (c.dim == 2) r.param.v = param.v;
+  }
+  return r;
+}
+
 void apply(MeshEditor& ed, Cavity& cav, VertId v, const Relocation& plan) {
   auto& m = ed.mesh();
   // Marked faces through v inside the ball (an interface between regions, a

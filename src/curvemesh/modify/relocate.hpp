@@ -47,6 +47,20 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cavity, VertId v);
 Relocation plan_relocation(MeshEditor& ed, Cavity& cavity, const BoundaryIndex& boundary, VertId v,
                            const geom::Model* model);
 
+/// Evaluates moving v to a position found by the caller: `target`, with
+/// `param` its parameters on v's model edge (u) or face (u, v) — target
+/// must lie on that entity (a closest point, say); ignored for a region
+/// vertex. Fills the cavity with v's ball; changes nothing. The same rules
+/// as plan_relocation except improvement, which is the caller's to judge
+/// (before / after are the ball's worst tet_quality now and at target):
+/// kClassification (a model vertex, a boundary vertex without a model, a
+/// vertex in no tet), kNotStarShaped (a tet of the ball would not be
+/// strictly positive, exact orient3d), kFoldedSurface (a boundary triangle
+/// through v would turn over, or against the model face where it agreed
+/// with it). `boundary` may be null for a region vertex.
+Relocation plan_relocation_to(MeshEditor& ed, Cavity& cavity, const BoundaryIndex* boundary, VertId v,
+                              const geom::Model* model, const Vec3& target, const mesh::Param& param);
+
 /// Moves v to plan.target (and its parameters to plan.param when set), and
 /// rebuilds its ball: same cavity, no other use in between. Marked faces
 /// through v stay marked.

@@ -15,6 +15,7 @@
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
 #include "curvemesh/modify/collapse.hpp"
+#include "curvemesh/modify/delete_tet.hpp"
 #include "curvemesh/modify/marks.hpp"
 #include "curvemesh/modify/relocate.hpp"
 #include "curvemesh/modify/split.hpp"
@@ -147,6 +148,26 @@ void refresh(MetricField& f, const AdaptOptions& o, const mesh::TetMesh& m, Vert
     const double h = o.sizes->size(x);
     f.set(v, size::Metric::Identity() / (h * h));
   }
+}
+
+// A tet on two or three faces of one model face goes (with a model) when it
+// is worse in the metric than every tet across its inner faces.
+bool delete_in_metric(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryIndex& boundary,
+                      const AdaptOptions& o, const MetricField& f, TetId t) {
+  const auto& m = ed.mesh();
+  int hull = 0;
+  for (int i = 0; i < 4; ++i) hull += m.tet2adj[mesh::pack_face(t, i)] == kNone;
+  if (!o.model || hull < 2 || hull == 4) return false;
+  const modify::TetDeletion plan =
+      modify::plan_tet_deletion(ed, cav, boundary, t, o.model, modify::DeletionOptions{o.chord_alpha});
+  if (plan.refusal != modify::Refusal::kNone) return false;
+  double across = 1;
+  for (int i = 0; i < 4; ++i)
+    if (const Index a = m.tet2adj[mesh::pack_face(t, i)]; a != kNone)
+      across = std::min(across, f.tet_quality(m, m.tet2verts[mesh::face_tet(a)]));
+  if (!(across > f.tet_quality(m, m.tet2verts[t]) + kMargin)) return false;
+  modify::apply(ed, cav, boundary, plan);
+  return true;
 }
 
 // A split or collapse may leave tets this poor: the shape pass that follows
@@ -282,43 +303,20 @@ std::size_t collapse_short_edges(modify::MeshEditor& ed, modify::Cavity& cav, mo
   return done;
 }
 
-// Drops the vertices collapses left in no tet: renumbers tets, boundary
-// triangles and edges, the per-vertex arrays and the field.
+// Drops the vertices collapses left in no tet, and their metrics.
 void drop_unused_vertices(mesh::TetMesh& m, MetricField& f) {
   const std::size_t nv = m.num_verts();
-  std::vector<VertId> old2new(nv, kNone);
-  std::vector<char> used(nv, 0);
-  for (const auto& tv : m.tet2verts)
-    for (VertId v : tv) used[v] = 1;
-  VertId next = 0;
-  for (VertId v = 0; v < nv; ++v)
-    if (used[v]) old2new[v] = next++;
-  if (next == nv) return;
-  MetricField kept;
+  const std::vector<VertId> old2new = mesh::drop_unused_vertices(m);
+  if (old2new.empty()) return;
   std::vector<size::Metric> tensors;
   std::vector<double> sizes;
   for (VertId v = 0; v < nv; ++v) {
-    if (!used[v]) continue;
-    const VertId w = old2new[v];
-    m.coords[w] = m.coords[v];
-    m.vert_class[w] = m.vert_class[v];
-    m.vert_param[w] = m.vert_param[v];
-    m.vert2tet[w] = m.vert2tet[v];
+    if (old2new[v] == kNone) continue;
     if (f.anisotropic())
       tensors.push_back(f.metric(v));
     else
       sizes.push_back(f.size_at(v));
   }
-  m.coords.resize(next);
-  m.vert_class.resize(next);
-  m.vert_param.resize(next);
-  m.vert2tet.resize(next);
-  for (auto& tv : m.tet2verts)
-    for (VertId& v : tv) v = old2new[v];
-  for (auto& t : m.tris)
-    for (VertId& v : t.verts) v = old2new[v];
-  for (auto& e : m.edges)
-    for (VertId& v : e.verts) v = old2new[v];
   f = f.anisotropic() ? MetricField::from_tensors(std::move(tensors)) : MetricField::from_sizes(sizes);
 }
 
@@ -393,6 +391,11 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
     std::sort(bad.begin(), bad.end());
     for (const auto& [q0, t] : bad) {
       if (ed.is_dead(t) || field.tet_quality(m, m.tet2verts[t]) >= o.threshold) continue;
+      if (o.deletion && delete_in_metric(ed, cav, boundary, o, field, t)) {
+        ++st.deletions;
+        ++changes;
+        continue;
+      }
       if (o.swaps) {
         Timer op;
         const bool done = reconnect(ed, cav, field, t, st);

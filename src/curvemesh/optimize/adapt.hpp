@@ -9,8 +9,11 @@
 // (longest first), collapse those shorter than 0.7 (shortest first, only
 // when no edge of the result is longer than 1.4, so the two never undo each
 // other), then improve the tets whose quality in the metric is below the
-// threshold: the best improving reconnection of the tet (edge removal on its
-// six edges, 2-3 swap on its four faces), else relocation of its vertices
+// threshold: with a model, its deletion when it stands on two or three
+// faces of one model face and is worse than the tets across
+// (modify/delete_tet.hpp), else the best improving reconnection of the tet
+// (edge removal on its six edges, 2-3 swap on its four faces), else
+// relocation of its vertices
 // toward the position that is best in the metric (boundary ones only with a
 // model, on it), else for an isotropic field a new point in the shell of
 // one of its interior edges (shell_insert.hpp). Edge removal chooses its
@@ -26,7 +29,9 @@
 // With a model (options.model, its tags those of the mesh's
 // classification), points split on boundary edges go onto the model and
 // boundary vertices collapse along their model entity (modify/split.hpp,
-// collapse.hpp). Boundary triangles are never swapped, classification is
+// collapse.hpp), and poor tets on the boundary may be deleted
+// (delete_tet.hpp: the surface then moves within the mesher's chord rule).
+// Boundary triangles are never swapped, classification is
 // kept, and no tet that is not strictly positive (exact orient3d) is ever
 // created.
 #include <cstddef>
@@ -50,6 +55,10 @@ struct AdaptOptions {
   /// Shell point insertion (shell_insert.hpp) for tets nothing else
   /// improves; isotropic fields only.
   bool insertion = true;
+  /// Element deletion of poor tets on the boundary (with a model only), and
+  /// the chord rule it keeps (modify::DeletionOptions).
+  bool deletion = true;
+  double chord_alpha = 0.04;
   /// The CAD model the mesh is classified on, or nullptr (boundary kept).
   const geom::Model* model = nullptr;
   /// The analytic size or metric the field was sampled from, or nullptr.
@@ -61,7 +70,8 @@ struct AdaptOptions {
 };
 
 struct AdaptStats {
-  std::size_t splits = 0, collapses = 0, edge_removals = 0, face_swaps = 0, relocations = 0, insertions = 0;
+  std::size_t splits = 0, collapses = 0, edge_removals = 0, face_swaps = 0, relocations = 0, insertions = 0,
+              deletions = 0;
   int passes = 0;
   /// Mean ratio in the metric (MetricField::tet_quality) over all tets.
   double min_before = 0, mean_before = 0, min_after = 0, mean_after = 0;

@@ -8,6 +8,8 @@
 #include "curvemesh/core/timer.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
+#include "curvemesh/modify/collapse.hpp"
+#include "curvemesh/modify/delete_tet.hpp"
 #include "curvemesh/modify/marks.hpp"
 #include "curvemesh/modify/measure.hpp"
 #include "curvemesh/modify/relocate.hpp"
@@ -15,6 +17,7 @@
 #include "curvemesh/modify/swap.hpp"
 #include "curvemesh/optimize/measured_swap.hpp"
 #include "curvemesh/optimize/shell_insert.hpp"
+#include "curvemesh/optimize/vertex_search.hpp"
 #include "curvemesh/quality/measures.hpp"
 
 namespace cm::optimize {
@@ -105,31 +108,111 @@ bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, Improve
   return true;
 }
 
-// With a model, boundary vertices move too, on their model entity.
+// Whether moving v to r.target is progress for its ball (the planners
+// judge the mean ratio; a move that raises it by flattening a sliver
+// elsewhere in the ball is none).
+bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation& r, std::vector<TetId>& ball) {
+  if (r.refusal != modify::Refusal::kNone) return false;
+  mesh::collect_ball(m, v, ball);
+  const auto before = worst_of(m, ball);
+  const Vec3 old = m.coords[v];
+  m.coords[v] = r.target;
+  const auto after = worst_of(m, ball);
+  m.coords[v] = old;
+  return is_progress(before.first, before.second, after.first, after.second);
+}
+
+// With a model, boundary vertices move too, on their model entity. The
+// Laplacian move first (cheap, and right for fair balls), else the search.
 bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::BoundaryIndex* boundary,
-                  const geom::Model* model, TetId t, ImproveStats& st, std::vector<TetId>& ball) {
+                  const ImproveOptions& o, bool search, TetId t, ImproveStats& st, std::vector<TetId>& ball) {
   bool moved = false;
   auto& m = ed.mesh();
   const auto tv = m.tet2verts[t];
   for (VertId v : tv) {
-    const auto r = model ? modify::plan_relocation(ed, cav, *boundary, v, model) : modify::plan_relocation(ed, cav, v);
-    if (r.refusal != modify::Refusal::kNone) continue;
-    // The planner raises the ball's worst mean ratio; a move that does so by
-    // flattening a sliver elsewhere in the ball is no progress.
-    mesh::collect_ball(m, v, ball);
-    const auto before = worst_of(m, ball);
-    const Vec3 old = m.coords[v];
-    m.coords[v] = r.target;
-    const auto after = worst_of(m, ball);
-    m.coords[v] = old;
-    if (!is_progress(before.first, before.second, after.first, after.second)) continue;
+    auto r = o.model ? modify::plan_relocation(ed, cav, *boundary, v, o.model) : modify::plan_relocation(ed, cav, v);
+    bool searched = false;
+    if (!relocation_progresses(m, v, r, ball)) {
+      if (!search) continue;
+      r = plan_searched_relocation(ed, cav, boundary, v, o.model, o.dihedral_threshold);
+      if (!relocation_progresses(m, v, r, ball)) continue;
+      searched = true;
+    }
     modify::apply(ed, cav, v, r);
     ++st.relocations;
     st.boundary_relocations += m.vert_class[v].dim < 3;
+    st.searched_relocations += searched;
     moved = true;
     if (ed.is_dead(t)) break;  // t was rebuilt: its other vertices are in new tets
   }
   return moved;
+}
+
+// A tet on two or three faces of one model face goes when it is worse than
+// the tets across its inner faces (they are what remains there).
+bool try_delete(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryIndex& boundary,
+                const ImproveOptions& o, TetId t, ImproveStats& st, std::vector<TetId>& touched) {
+  const auto& m = ed.mesh();
+  int hull = 0;
+  for (int f = 0; f < 4; ++f) hull += m.tet2adj[mesh::pack_face(t, f)] == kNone;
+  if (hull < 2 || hull == 4) return false;
+  const modify::TetDeletion plan =
+      modify::plan_tet_deletion(ed, cav, boundary, t, o.model, modify::DeletionOptions{o.chord_alpha});
+  if (plan.refusal != modify::Refusal::kNone) return false;
+  std::pair<double, double> across{1, 1}, self{1, 1};
+  for (int f = 0; f < 4; ++f)
+    if (const Index a = m.tet2adj[mesh::pack_face(t, f)]; a != kNone) take_worst(m, m.tet2verts[mesh::face_tet(a)], across);
+  take_worst(m, m.tet2verts[t], self);
+  if (!is_progress(std::min(self.first, across.first), std::min(self.second, across.second), across.first,
+                   across.second))
+    return false;
+  // The tets across now stand on the boundary with one more face: worth a
+  // look again (nothing new was created for the hook to report).
+  for (int f = 0; f < 4; ++f)
+    if (const Index a = m.tet2adj[mesh::pack_face(t, f)]; a != kNone) touched.push_back(mesh::face_tet(a));
+  modify::apply(ed, cav, boundary, plan);
+  ++st.deletions;
+  return true;
+}
+
+// The best collapse of an edge of t (either way): a vertex goes when the
+// tets that remain of its ball are progress over the ball. Along a model
+// edge or face only with the model (the collapse's own rules), so a thin
+// triangle at a sharp corner of a face can lengthen until it is no longer
+// thin.
+bool try_collapse(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryIndex& boundary,
+                  const geom::Model* model, TetId t, ImproveStats& st) {
+  auto& m = ed.mesh();
+  const auto tv = m.tet2verts[t];
+  int best = -1;
+  std::pair<double, double> best_after{-1, -1};
+  for (int k = 0; k < 12; ++k) {
+    const auto& e = mesh::kTetEdges[static_cast<std::size_t>(k % 6)];
+    const VertId from = tv[static_cast<std::size_t>(k < 6 ? e[0] : e[1])], to = tv[static_cast<std::size_t>(k < 6 ? e[1] : e[0])];
+    if (m.vert_class[from].dim != 3 && !model) continue;
+    const auto plan = modify::plan_collapse(ed, cav, boundary, from, to, model);
+    if (plan.refusal != modify::Refusal::kNone) continue;
+    const auto before = worst_of(m, cav.tets());
+    std::pair<double, double> after{1, 1};
+    for (TetId u : cav.tets()) {
+      auto nv = m.tet2verts[u];
+      if (std::find(nv.begin(), nv.end(), to) != nv.end()) continue;
+      for (VertId& x : nv)
+        if (x == from) x = to;
+      take_worst(m, nv, after);
+    }
+    if (!is_progress(before.first, before.second, after.first, after.second)) continue;
+    if (std::pair{after.second, after.first} <= std::pair{best_after.second, best_after.first}) continue;
+    best = k;
+    best_after = after;
+  }
+  if (best < 0) return false;
+  const auto& e = mesh::kTetEdges[static_cast<std::size_t>(best % 6)];
+  const VertId from = tv[static_cast<std::size_t>(best < 6 ? e[0] : e[1])], to = tv[static_cast<std::size_t>(best < 6 ? e[1] : e[0])];
+  const auto plan = modify::plan_collapse(ed, cav, boundary, from, to, model);
+  modify::apply(ed, cav, boundary, plan);
+  ++st.collapses;
+  return true;
 }
 
 // The best point insertion for t: in the shell of one of its six edges,
@@ -161,9 +244,8 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
   ImproveStats st;
   modify::MeshEditor ed(m);
   modify::mark_boundary_faces(ed);
-  // Only model-aware relocation reads it; it never edits m.tris or m.edges.
-  std::unique_ptr<modify::BoundaryIndex> boundary;
-  if (o.model) boundary = std::make_unique<modify::BoundaryIndex>(m);
+  // Model-aware relocation reads it, element deletion edits it.
+  std::unique_ptr<modify::BoundaryIndex> boundary = std::make_unique<modify::BoundaryIndex>(m);
   modify::Cavity cav;
   const Summary before = summarize(ed, o.threshold);
   st.min_before = before.min;
@@ -172,9 +254,33 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
   st.min_dihedral_before = before.min_dihedral;
   std::vector<std::pair<double, TetId>> bad;
   std::vector<TetId> ball;
+  // After the first pass only the tets an operation made (the hook reports
+  // them) and those still waiting can need work: no pass rescans the mesh.
+  std::vector<TetId> touched, candidates;
+  ed.set_hook([&touched](const mesh::TetMesh&, std::span<const TetId> created) {
+    touched.insert(touched.end(), created.begin(), created.end());
+  });
+  // The search and collapses wait until the cheap operators are stuck: the
+  // search drives the mean ratio of the balls it improves down to the
+  // progress floor, which then holds their neighbours, and a collapse
+  // coarsens; both are for what the others cannot repair.
+  // Stuck: a pass that changed nothing, or left the worst tet as it was.
+  bool stuck = false;
+  double last_worst = -1;
   for (st.passes = 0; st.passes < o.passes; ++st.passes) {
+    if (st.passes == 0) {
+      candidates.resize(m.tet2verts.size());
+      for (TetId t = 0; t < m.tet2verts.size(); ++t) candidates[t] = t;
+    } else {
+      candidates.clear();
+      for (const auto& [q, t] : bad) candidates.push_back(t);
+      candidates.insert(candidates.end(), touched.begin(), touched.end());
+      std::sort(candidates.begin(), candidates.end());
+      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    }
+    touched.clear();
     bad.clear();
-    for (TetId t = 0; t < m.tet2verts.size(); ++t) {
+    for (TetId t : candidates) {
       if (ed.is_dead(t)) continue;
       const double q = modify::tet_quality(m, m.tet2verts[t]);
       // Worst angle-aware shape first: slivers before fair-angled tets of
@@ -183,9 +289,20 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
     }
     if (bad.empty()) break;
     std::sort(bad.begin(), bad.end());
+    if (!(bad.front().first > last_worst + 1e-6) && st.passes > 0) stuck = true;
+    last_worst = bad.front().first;
     std::size_t changes = 0;
     for (const auto& [q0, t] : bad) {
       if (ed.is_dead(t) || !needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o)) continue;
+      if (o.deletion && o.model) {
+        Timer op;
+        const bool done = try_delete(ed, cav, *boundary, o, t, st, touched);
+        st.deletion_seconds += op.seconds();
+        if (done) {
+          ++changes;
+          continue;
+        }
+      }
       if (o.swaps) {
         Timer op;
         const bool done = try_reconnect(ed, cav, t, st);
@@ -197,9 +314,18 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
       }
       if (o.relocation) {
         Timer op;
-        const bool moved = try_relocate(ed, cav, boundary.get(), o.model, t, st, ball);
+        const bool moved = try_relocate(ed, cav, boundary.get(), o, stuck && o.search, t, st, ball);
         st.relocation_seconds += op.seconds();
         if (moved) {
+          ++changes;
+          continue;
+        }
+      }
+      if (o.collapse && stuck) {
+        Timer op;
+        const bool done = try_collapse(ed, cav, *boundary, o.model, t, st);
+        st.collapse_seconds += op.seconds();
+        if (done) {
           ++changes;
           continue;
         }
@@ -210,9 +336,14 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
         st.insertion_seconds += op.seconds();
       }
     }
-    if (changes == 0) break;
+    if (changes == 0) {
+      if (stuck || (!o.search && !o.collapse)) break;
+      stuck = true;
+    }
   }
+  ed.set_hook({});
   ed.compact();
+  mesh::drop_unused_vertices(m);
   const Summary after = summarize(ed, o.threshold);
   st.min_after = after.min;
   st.mean_after = after.mean;

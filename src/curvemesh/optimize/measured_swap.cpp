@@ -17,10 +17,22 @@ double angle_aware_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Ve
   return std::max(std::min(quality::tet_mean_ratio(a, b, c, d), angle), 0.0);
 }
 
+std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return {-1, -1};
+  constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
+  const double mr = std::max(quality::tet_mean_ratio(a, b, c, d), 0.0);
+  return {mr, std::min(mr, quality::tet_dihedral_range(a, b, c, d).min / kRegularDihedral)};
+}
+
+double mean_ratio_floor(double mr_before, double shape_before) {
+  constexpr double kTenDegrees = 10.0 / 70.528779365509308;  // angle-aware quality of a 10 degree tet
+  return std::min(mr_before, shape_before < kTenDegrees ? kRescueFloor : kProgressFloor);
+}
+
 bool is_progress(double mr_before, double shape_before, double mr_after, double shape_after) {
-  constexpr double kFloor = 0.2, kMargin = 1e-6;
+  constexpr double kFloor = kProgressFloor, kMargin = 1e-6;
   if (!(mr_after > 0) || !(shape_after > 0)) return false;
-  return (shape_after > shape_before + kMargin && mr_after >= std::min(mr_before, kFloor)) ||
+  return (shape_after > shape_before + kMargin && mr_after >= mean_ratio_floor(mr_before, shape_before)) ||
          (mr_after > mr_before + kMargin && shape_after >= std::min(shape_before, kFloor));
 }
 

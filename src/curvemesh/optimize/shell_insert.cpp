@@ -7,6 +7,7 @@
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/modify/surface.hpp"
 #include "curvemesh/optimize/measured_swap.hpp"
+#include "curvemesh/optimize/vertex_search.hpp"
 
 namespace cm::optimize {
 
@@ -50,6 +51,10 @@ Vec3 star_centroid(const mesh::TetMesh& m, std::span<const modify::CavityFace> f
 // vertices and their middle, each smoothed while its angle-aware quality
 // rises; the best that is progress (is_progress) wins. Sets after (the
 // angle-aware quality), point and the refusal.
+// The angle-aware quality of a tet whose smallest dihedral angle is 12
+// degrees: the point search stops short of it (vertex_search.hpp).
+constexpr double kSearchBelow = 12.0 / 70.528779365509308;
+
 void place_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> faces, const Vec3& guess,
                  std::pair<double, double> before, ShellInsertion& plan) {
   Vec3 centroid = Vec3::Zero();
@@ -58,6 +63,16 @@ void place_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> fac
   plan.before = before.second;
   plan.after = -1;
   bool positive = false;
+  Vec3 best = guess;
+  std::pair<double, double> best_q{-1, -1};
+  auto consider = [&](const Vec3& x, const std::pair<double, double>& q) {
+    positive |= q.second > 0;
+    if (q.second > best_q.second) best = x, best_q = q;
+    if (q.second > plan.after && is_progress(before.first, before.second, q.first, q.second)) {
+      plan.after = q.second;
+      plan.point = x;
+    }
+  };
   for (const Vec3& start : {guess, centroid, Vec3(0.5 * (guess + centroid))}) {
     Vec3 x = start;
     auto q = star_quality(m, faces, x);
@@ -68,11 +83,14 @@ void place_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> fac
       x = y;
       q = qy;
     }
-    positive |= q.second > 0;
-    if (q.second > plan.after && is_progress(before.first, before.second, q.first, q.second)) {
-      plan.after = q.second;
-      plan.point = x;
-    }
+    consider(x, q);
+  }
+  // Smoothing finds the middle of a fair cavity; a flat one (a sliver's
+  // four boundary vertices) needs the point where its worst tet is best:
+  // searched for from the best smoothed point, when that is not good enough.
+  if (best_q.second > 0 && best_q.second < kSearchBelow) {
+    const Vec3 y = search_star_point(m, faces, best, mean_ratio_floor(before.first, before.second));
+    consider(y, star_quality(m, faces, y));
   }
   if (!positive)
     plan.refusal = modify::Refusal::kNotStarShaped;

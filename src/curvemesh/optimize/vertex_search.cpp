@@ -1,0 +1,242 @@
+#include "curvemesh/optimize/vertex_search.hpp"
+
+#include <algorithm>
+#include <span>
+#include <vector>
+
+#include "curvemesh/mesh/adjacency.hpp"
+#include "curvemesh/mesh/topology.hpp"
+#include "curvemesh/optimize/measured_swap.hpp"
+
+namespace cm::optimize {
+
+namespace {
+
+// A point of the search: where it is, its parameters on the entity, and
+// its rank: the worst angle-aware quality of the tets it makes up to the
+// goal (-1 where a tet would be invalid or its mean ratio under the floor),
+// then their worst mean ratio. Past the goal the search raises the mean
+// ratio instead of trading it for angles no one asked for.
+struct Poll {
+  Vec3 point = Vec3::Zero();
+  Vec2 param = Vec2::Zero();
+  double score = -1, tie = -1;
+};
+
+bool better(const Poll& p, const Poll& q, double margin) {
+  return p.score > q.score + margin || (p.score >= q.score - 1e-12 && p.tie > q.tie + margin);
+}
+
+constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
+
+// Compass search from `first` (offset 0): each round polls the directions
+// `guided` proposes at the current best, then ± each axis of `frame`, at
+// step h, and moves to the first poll that improves (then on along it, the
+// step doubling, while that pays); a round without improvement halves h.
+// Stops after max_polls polls or when h falls under h0 / 64.
+// poll_at(offset) -> Poll; guided(point, directions&) appends unit vectors.
+template <class PollAt, class Guided>
+Poll compass_search(const Poll& first, std::span<const Vec3> frame, double h0, int max_polls, PollAt&& poll_at,
+                    Guided&& guided) {
+  Poll best = first;
+  Vec3 offset = Vec3::Zero();
+  double h = h0;
+  int polls = 0;
+  thread_local std::vector<Vec3> directions;
+  while (polls < max_polls && h > h0 / 64) {
+    directions.clear();
+    guided(best.point, directions);
+    for (const Vec3& axis : frame) {
+      directions.push_back(axis);
+      directions.push_back(-axis);
+    }
+    bool moved = false;
+    for (const Vec3& d : directions) {
+      if (polls >= max_polls) break;
+      ++polls;
+      const Poll p = poll_at(offset + h * d);
+      if (!better(p, best, 1e-9)) continue;
+      best = p;
+      offset += h * d;
+      moved = true;
+      // Keep going while it pays: a sliver may need a long way.
+      while (polls < max_polls) {
+        ++polls;
+        const Poll q = poll_at(offset + 2 * h * d);
+        if (!better(q, best, 1e-9)) break;
+        best = q;
+        h *= 2;
+        offset += h * d;
+      }
+      break;
+    }
+    if (!moved) h *= 0.5;
+  }
+  return best;
+}
+
+}  // namespace
+
+modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavity& cav,
+                                            const modify::BoundaryIndex* boundary, VertId v,
+                                            const geom::Model* model, double angle_goal, int max_polls) {
+  auto& m = ed.mesh();
+  modify::Relocation refused;
+  refused.refusal = modify::Refusal::kClassification;
+  const mesh::ModelRef c = v < m.vert_class.size() ? m.vert_class[v] : mesh::ModelRef{};
+  const int dim = c.dim == 3 ? 3 : c.dim == 2 ? 2 : c.dim == 1 ? 1 : 0;
+  if (dim == 0 || m.vert2tet[v] == kNone || (dim < 3 && (!model || !boundary))) return refused;
+
+  thread_local std::vector<TetId> ball;
+  mesh::collect_ball(m, v, ball);
+  const Vec3 start = m.coords[v];
+  // Ranks a position (see Poll), the mean ratio floor being what
+  // is_progress keeps the ball's worst at (mean_ratio_floor of its worst
+  // now), so the search never leaves what the driver accepts.
+  const double goal = angle_goal / kRegularDihedral;
+  double floor = -1;
+  auto rank_at = [&](Poll& p) {
+    m.coords[v] = p.point;
+    double shape = 1, mr = 1;
+    for (TetId t : ball) {
+      const auto& tv = m.tet2verts[t];
+      const auto q = mean_ratio_and_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
+      mr = std::min(mr, q.first);
+      shape = std::min(shape, q.second);
+      if (shape <= 0 || mr < floor) break;
+    }
+    m.coords[v] = start;
+    if (floor < 0) floor = mean_ratio_floor(mr, shape);  // the first call: at the start
+    const bool ok = shape > 0 && mr >= floor;
+    p.score = ok ? std::min(shape, goal) : -1;
+    p.tie = ok ? mr : -1;
+  };
+  // The entity's tangent frame at the start; polls are offsets in it.
+  const geom::EntityRef entity{c.dim, c.tag};
+  Vec2 param0 = Vec2::Zero();
+  std::array<Vec3, 3> frame{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+  if (dim < 3) {
+    const mesh::Param& own = m.vert_param[v];
+    param0 = own.has_u() && (dim == 1 || !std::isnan(own.v)) ? Vec2(own.u, dim == 1 ? 0.0 : own.v)
+                                                               : model->closest_point(entity, start).param;
+    if (dim == 2) {
+      const Vec3 n = model->face_normal(c.tag, param0);
+      const Vec3 a = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+      frame[0] = n.cross(a).normalized();
+      frame[1] = n.cross(frame[0]);
+    } else {
+      const Vec3 t = model->edge_derivatives(c.tag, param0.x()).d1;
+      if (!(t.squaredNorm() > 0)) return refused;
+      frame[0] = t.normalized();
+    }
+  }
+  auto tangential = [&](const Vec3& d) {
+    Vec3 r = Vec3::Zero();
+    for (int k = 0; k < dim; ++k) r += d.dot(frame[static_cast<std::size_t>(k)]) * frame[static_cast<std::size_t>(k)];
+    return r;
+  };
+  auto poll_at = [&](const Vec3& offset) {
+    Poll p;
+    if (dim == 3) {
+      p.point = start + offset;
+    } else {
+      const geom::Projection pr = model->closest_point(entity, start + offset, param0);
+      p.point = pr.point;
+      p.param = pr.param;
+    }
+    rank_at(p);
+    return p;
+  };
+
+  // Step: a tenth of the mean distance to the ball's other vertices.
+  double spread = 0;
+  int count = 0;
+  Vec3 centroid = Vec3::Zero();
+  for (TetId t : ball)
+    for (VertId w : m.tet2verts[t])
+      if (w != v) {
+        spread += (m.coords[w] - start).norm();
+        centroid += m.coords[w];
+        ++count;
+      }
+  centroid /= count;
+  const double h0 = 0.1 * spread / count;
+
+  Poll first;
+  first.point = start;
+  first.param = param0;
+  rank_at(first);
+  auto lift_and_pull = [&](const Vec3& at, std::vector<Vec3>& directions) {
+    // The worst tet's vertex lifted off its opposite face (the move that
+    // opens a sliver), then the pull toward the centroid.
+    m.coords[v] = at;
+    TetId worst = ball.front();
+    double worst_q = 2;
+    for (TetId t : ball) {
+      const double q = angle_aware_measure(m, m.tet2verts[t], nullptr);
+      if (q < worst_q) worst_q = q, worst = t;
+    }
+    m.coords[v] = start;
+    const auto& tv = m.tet2verts[worst];
+    const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(mesh::local_index(m, worst, v))];
+    // The face's normal points out of the tet, away from v.
+    const Vec3 n = -(m.coords[tv[fv[1]]] - m.coords[tv[fv[0]]]).cross(m.coords[tv[fv[2]]] - m.coords[tv[fv[0]]]);
+    if (const Vec3 lift = tangential(n); lift.squaredNorm() > 0) directions.push_back(lift.normalized());
+    if (const Vec3 pull = tangential(centroid - at); pull.squaredNorm() > 0) directions.push_back(pull.normalized());
+  };
+  const Poll best = compass_search(first, std::span<const Vec3>(frame.data(), static_cast<std::size_t>(dim)), h0,
+                                   max_polls, poll_at, lift_and_pull);
+  if (!better(best, first, 1e-6)) {
+    modify::Relocation r;
+    r.refusal = modify::Refusal::kNoImprovement;
+    return r;
+  }
+  mesh::Param param;
+  param.u = best.param.x();
+  if (dim == 2) param.v = best.param.y();
+  return modify::plan_relocation_to(ed, cav, boundary, v, model, best.point, param);
+}
+
+Vec3 search_star_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> faces, const Vec3& start,
+                       double mean_ratio_floor, double angle_goal, int max_polls) {
+  // A boundary face lists its vertices with the normal out of the cavity,
+  // so (f1, f0, f2, x) is the positive order of the star's tet.
+  auto tet_score = [&](const modify::CavityFace& f, const Vec3& x) {
+    return angle_aware_quality(m.coords[f.verts[1]], m.coords[f.verts[0]], m.coords[f.verts[2]], x);
+  };
+  const double goal = angle_goal / kRegularDihedral;
+  auto poll_at = [&](const Vec3& offset) {
+    Poll p;
+    p.point = start + offset;
+    double shape = 1, mr = 1;
+    for (const auto& f : faces) {
+      const auto q = mean_ratio_and_shape(m.coords[f.verts[1]], m.coords[f.verts[0]], m.coords[f.verts[2]], p.point);
+      mr = std::min(mr, q.first);
+      shape = std::min(shape, q.second);
+      if (shape <= 0 || mr < mean_ratio_floor) break;
+    }
+    const bool ok = shape > 0 && mr >= mean_ratio_floor;
+    p.score = ok ? std::min(shape, goal) : -1;
+    p.tie = ok ? mr : -1;
+    return p;
+  };
+  double spread = 0;
+  for (const auto& f : faces)
+    for (VertId w : f.verts) spread += (m.coords[w] - start).norm();
+  const double h0 = 0.1 * spread / (3.0 * static_cast<double>(faces.size()));
+  // Guided: the worst tet's apex lifted off its face, into the cavity.
+  auto lift = [&](const Vec3& at, std::vector<Vec3>& directions) {
+    const modify::CavityFace* worst = nullptr;
+    double worst_q = 2;
+    for (const auto& f : faces)
+      if (const double q = tet_score(f, at); q < worst_q) worst_q = q, worst = &f;
+    if (!worst) return;
+    const Vec3 &a = m.coords[worst->verts[0]], &b = m.coords[worst->verts[1]], &c = m.coords[worst->verts[2]];
+    const Vec3 n = -(b - a).cross(c - a);
+    if (n.squaredNorm() > 0) directions.push_back(n.normalized());
+  };
+  const std::array<Vec3, 3> frame{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+  return compass_search(poll_at(Vec3::Zero()), frame, h0, max_polls, poll_at, lift).point;
+}
+
+}  // namespace cm::optimize
