@@ -7,6 +7,7 @@
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
 #include "curvemesh/modify/measure.hpp"
+#include "curvemesh/modify/ring_triangulation.hpp"
 
 namespace cm::modify {
 
@@ -64,43 +65,18 @@ Plan plan_edge_removal(MeshEditor& ed, Cavity& cav, VertId a, VertId b, TetId st
     return ccw_from_a ? std::array<std::array<VertId, 4>, 2>{{{ri, rj, rk, a}, {rj, ri, rk, b}}}
                       : std::array<std::array<VertId, 4>, 2>{{{rj, ri, rk, a}, {ri, rj, rk, b}}};
   };
-  // best[i][j]: worst quality of the best triangulation of ring i..j.
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  double best[kMaxShell][kMaxShell];
-  int pick[kMaxShell][kMaxShell];
-  for (int i = 0; i + 1 < n; ++i) best[i][i + 1] = kInf;
-  for (int len = 2; len < n; ++len)
-    for (int i = 0; i + len < n; ++i) {
-      const int j = i + len;
-      best[i][j] = -kInf;
-      pick[i][j] = -1;
-      for (int k = i + 1; k < j; ++k) {
-        const double side = std::min(best[i][k], best[k][j]);
-        if (side <= best[i][j]) continue;
-        const auto t2 = tets_of(i, k, j);
-        const double q = std::min({side, tet_quality(m, t2[0]), tet_quality(m, t2[1])});
-        if (q > best[i][j]) {
-          best[i][j] = q;
-          pick[i][j] = k;
-        }
-      }
-    }
-  plan.after = best[0][n - 1];
+  const RingTriangulation best = triangulate_ring(n, [&](int i, int k, int j) {
+    const auto tv = tets_of(i, k, j);
+    return std::min(tet_quality(m, tv[0]), tet_quality(m, tv[1]));
+  });
+  plan.after = best.worst;
   if (!(plan.after > 0)) {
     plan.refusal = Refusal::kNotStarShaped;
     return plan;
   }
-  // Unfold the choice.
-  std::array<std::pair<int, int>, kMaxShell> stack{};
-  int top = 0;
-  stack[top++] = {0, n - 1};
-  while (top > 0) {
-    const auto [i, j] = stack[--top];
-    if (j - i < 2) continue;
-    const int k = pick[i][j];
-    for (const auto& tv : tets_of(i, k, j)) plan.fill.push_back({tv, region});
-    stack[top++] = {i, k};
-    stack[top++] = {k, j};
+  for (int t = 0; t < best.count; ++t) {
+    const auto& tri = best.triangles[static_cast<std::size_t>(t)];
+    for (const auto& tv : tets_of(tri[0], tri[1], tri[2])) plan.fill.push_back({tv, region});
   }
   if (plan.after <= plan.before) plan.refusal = Refusal::kNoImprovement;
   return plan;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "curvemesh/modify/cavity.hpp"
+#include "curvemesh/modify/ring_triangulation.hpp"
 
 namespace cm::modify {
 
@@ -28,7 +29,7 @@ struct Plan {
 };
 
 /// Largest shell edge removal considers (the DP is cubic in it).
-inline constexpr int kMaxShell = 12;
+inline constexpr int kMaxShell = kMaxRing;
 
 /// Plans the removal of edge (a, b); `start` is a live tet containing it.
 Plan plan_edge_removal(MeshEditor& ed, Cavity& cavity, VertId a, VertId b, TetId start);

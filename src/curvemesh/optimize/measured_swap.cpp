@@ -6,6 +6,7 @@
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
+#include "curvemesh/modify/ring_triangulation.hpp"
 #include "curvemesh/quality/measures.hpp"
 
 namespace cm::optimize {
@@ -98,52 +99,20 @@ modify::Plan plan_measured_edge_removal(modify::MeshEditor& ed, modify::Cavity& 
     return ccw_from_a ? std::array<std::array<VertId, 4>, 2>{{{ri, rj, rk, a}, {rj, ri, rk, b}}}
                       : std::array<std::array<VertId, 4>, 2>{{{rj, ri, rk, a}, {ri, rj, rk, b}}};
   };
-  // A triangle (i, k, j) of the ring appears in many sub-polygons: measure
-  // its two tets once.
-  constexpr double kUnset = -std::numeric_limits<double>::infinity();
-  double tri[kMax][kMax][kMax];
-  for (int i = 0; i < n; ++i)
-    for (int k = i + 1; k < n; ++k)
-      for (int j = k + 1; j < n; ++j) tri[i][k][j] = kUnset;
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  double best[kMax][kMax];
-  int pick[kMax][kMax];
-  for (int i = 0; i + 1 < n; ++i) best[i][i + 1] = kInf;
-  for (int len = 2; len < n; ++len)
-    for (int i = 0; i + len < n; ++i) {
-      const int j = i + len;
-      best[i][j] = -kInf;
-      pick[i][j] = -1;
-      for (int k = i + 1; k < j; ++k) {
-        const double side = std::min(best[i][k], best[k][j]);
-        if (side <= best[i][j]) continue;
-        double& t2 = tri[i][k][j];
-        if (t2 == kUnset) {
-          const auto tv = tets_of(i, k, j);
-          t2 = std::min(measure(m, tv[0], context), measure(m, tv[1], context));
-        }
-        const double q = std::min(side, t2);
-        if (q > best[i][j]) {
-          best[i][j] = q;
-          pick[i][j] = k;
-        }
-      }
-    }
-  plan.after = best[0][n - 1];
+  // The ring's best triangulation; each triangle (i, k, j) of the ring is
+  // measured once, through its two tets.
+  const modify::RingTriangulation best = modify::triangulate_ring(n, [&](int i, int k, int j) {
+    const auto tv = tets_of(i, k, j);
+    return std::min(measure(m, tv[0], context), measure(m, tv[1], context));
+  });
+  plan.after = best.worst;
   if (!(plan.after > 0)) {
     plan.refusal = Refusal::kNotStarShaped;
     return plan;
   }
-  std::array<std::pair<int, int>, kMax> stack{};
-  int top = 0;
-  stack[top++] = {0, n - 1};
-  while (top > 0) {
-    const auto [i, j] = stack[--top];
-    if (j - i < 2) continue;
-    const int k = pick[i][j];
-    for (const auto& tv : tets_of(i, k, j)) plan.fill.push_back({tv, region});
-    stack[top++] = {i, k};
-    stack[top++] = {k, j};
+  for (int t = 0; t < best.count; ++t) {
+    const auto& tri = best.triangles[static_cast<std::size_t>(t)];
+    for (const auto& tv : tets_of(tri[0], tri[1], tri[2])) plan.fill.push_back({tv, region});
   }
   if (plan.after <= plan.before) plan.refusal = Refusal::kNoImprovement;
   return plan;
