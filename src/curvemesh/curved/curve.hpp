@@ -39,6 +39,8 @@ struct CurveReport {
   PlacementStats placement;
   /// Right after placing the nodes, and at the end.
   std::size_t invalid_before = 0, unacceptable_before = 0;
+  /// Minimum I before repair: a lower bound (I is computed where it decides
+  /// acceptability, and bounded by the scaled Jacobian elsewhere).
   double min_scaled_jacobian_before = 1, min_measure_before = 1;
   MeshCheck after;
   RepairStats repair;

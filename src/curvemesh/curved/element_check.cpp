@@ -43,7 +43,8 @@ bool has_any_node(const mesh::TetMesh& m, const std::array<VertId, 4>& v) {
 
 }  // namespace
 
-ElementCheck check_element(int order, std::span<const Vec3> nodes, const Acceptance& acceptance) {
+ElementCheck check_element(int order, std::span<const Vec3> nodes, const Acceptance& acceptance,
+                           bool exact_measure) {
   ElementCheck c;
   if (order == 1 || is_straight(order, nodes)) {
     if (predicates::orient3d(nodes[0].data(), nodes[1].data(), nodes[2].data(), nodes[3].data()) <= 0) {
@@ -67,13 +68,18 @@ ElementCheck check_element(int order, std::span<const Vec3> nodes, const Accepta
   c.scaled_jacobian = r.verdict == quality::Validity::kValid ? r.scaled_jacobian_lower
                                                              : std::min(0.0, r.scaled_jacobian_lower);
   c.where = r.where_entity;
-  c.measure = quality::shape_measure(order, nodes).measure;
+  if (!exact_measure && c.verdict == quality::Validity::kValid && c.scaled_jacobian >= acceptance.min_measure) {
+    c.measure = c.scaled_jacobian;
+    c.measure_exact = false;
+  } else {
+    c.measure = quality::shape_measure(order, nodes).measure;
+  }
   c.acceptable = c.verdict == quality::Validity::kValid && c.scaled_jacobian >= acceptance.min_scaled_jacobian &&
                  c.measure >= acceptance.min_measure;
   return c;
 }
 
-ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& acceptance) {
+ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& acceptance, bool exact_measure) {
   // Most tets have at most one vertex on the boundary, hence no boundary
   // edge and no nodes: straight, decided by orient3d alone.
   const auto& v = m.tet2verts[t];
@@ -83,14 +89,15 @@ ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& accept
     const std::array<Vec3, 4> corners{m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]};
     if (m.high_order.num_edges() == 0 || !has_any_node(m, v)) return check_element(1, corners, acceptance);
   }
-  return check_element(m.high_order.order(), mesh::gather_tet_nodes(m, t), acceptance);
+  return check_element(m.high_order.order(), mesh::gather_tet_nodes(m, t), acceptance, exact_measure);
 }
 
-MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance) {
+MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures) {
   const std::size_t nt = m.num_tets();
   std::vector<ElementCheck> checks(nt);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 256), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) checks[t] = check_tet(m, static_cast<TetId>(t), acceptance);
+    for (std::size_t t = r.begin(); t != r.end(); ++t)
+      checks[t] = check_tet(m, static_cast<TetId>(t), acceptance, exact_measures);
   });
   MeshCheck out;
   double sum_sj = 0, sum_i = 0;

@@ -916,7 +916,7 @@ RepairStats Repairer::run(std::span<const TetId> unacceptable) {
     // list is made again.
     if (!interior_curved_.empty()) {
       ed_.compact();
-      bad = check_mesh(m_, o_.acceptance).unacceptable;
+      bad = check_mesh(m_, o_.acceptance, false).unacceptable;
     }
   }
   if (o_.straighten) straighten(bad);
