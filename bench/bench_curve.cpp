@@ -15,6 +15,7 @@
 //                                Zylkopf H=2, Torus_1 and ring H=80, t20 H=1.2),
 //                                the other shared models at diagonal / 8
 //   bench_curve MODEL H [...]    given cases
+//   bench_curve --ours-only ...  without the Gmsh runs (quick curving timings)
 // Gmsh gets kGmshSeconds per run. Times are wall clock (the machine may be
 // shared: compare ratios measured in one run).
 #include <sys/resource.h>
@@ -119,6 +120,12 @@ GmshRow run_gmsh(const Case& c, double h, const cm::geom::Model& model, bool opt
 }  // namespace
 
 int main(int argc, char** argv) {
+  bool ours_only = false;
+  if (argc >= 2 && std::string(argv[1]) == "--ours-only") {
+    ours_only = true;
+    --argc;
+    ++argv;
+  }
   std::vector<Case> cases;
   if (argc >= 3) {
     for (int i = 1; i + 1 < argc; i += 2) {
@@ -139,7 +146,7 @@ int main(int argc, char** argv) {
       cases.push_back({f, h});
     }
   }
-  const bool have_gmsh = std::system("gmsh --version > /dev/null 2>&1") == 0;
+  const bool have_gmsh = !ours_only && std::system("gmsh --version > /dev/null 2>&1") == 0;
   const fs::path tmp = fs::temp_directory_path() / fmt::format("curvemesh_bench_curve_{}", getpid());
   fs::create_directories(tmp);
   fmt::print("{:<28} {:>7} | {:>7} {:>6} | {:>2} {:>6} {:>5} {:>5} {:>7} {:>6} {:>5} {:>8} | {:>7} {:>6} {:>4} {:>7} "
@@ -182,7 +189,7 @@ int main(int argc, char** argv) {
         if (order == 2 && plain.ok)
           fmt::print("{:>7.2f} {:>6} {:>4} {:>7.4f} | ", plain.seconds, plain.tets, plain.invalid, plain.min_sj);
         else
-          fmt::print("{:>28} | ", order == 2 ? (have_gmsh ? "gmsh failed" : "no gmsh") : "");
+          fmt::print("{:>28} | ", order == 2 ? (have_gmsh ? "gmsh failed" : ours_only ? "" : "no gmsh") : "");
         if (order == 2 && optimized.ok)
           fmt::print("{:>6.2f} {:>4} {:>7.4f} {:>6.0f} | ", optimized.seconds, optimized.invalid, optimized.min_sj,
                      optimized.peak_rss / 1e6);

@@ -189,8 +189,11 @@ class Repairer {
   // Records the entities of the tets an edit is about to replace.
   void before_edit(std::span<const TetId> old);
   void after_edit(std::span<const TetId> created);
-  void refresh_edge(VertId a, VertId b, TetId t);
-  void refresh_face(VertId a, VertId b, VertId c);
+  // Both return whether the entity's nodes changed (appeared, went, moved).
+  bool refresh_edge(VertId a, VertId b, TetId t);
+  bool refresh_face(VertId a, VertId b, VertId c);
+  // Queues for a new check the live tets holding face (a, b, c).
+  void recheck_face(VertId a, VertId b, VertId c);
   TetId find_tet_with(VertId a, VertId b) const;
 
   // --- steps ---------------------------------------------------------------
@@ -228,7 +231,39 @@ class Repairer {
   std::unordered_set<std::uint64_t> interior_curved_;
   // Tets created since the list of unacceptable tets was last updated.
   std::vector<TetId> created_;
+  // Every step judges only tets through a vertex of the tet it repairs, so
+  // a tet all steps failed on fails again until an edit creates a tet
+  // through one of its vertices: edits are counted (clock_), vertices
+  // stamped with the last edit that touched them, failures with the clock.
+  std::uint64_t clock_ = 0;
+  std::vector<std::uint64_t> vert_stamp_;
+  std::vector<std::uint64_t> failed_at_;  // per tet; 0: not failed
+  void stamp(std::span<const TetId> tets);
+  bool unchanged_since_failure(TetId t) const;
+  void note_failure(TetId t);
+  // Tets whose nodes curve_interior changed.
+  std::vector<TetId> touched_;
 };
+
+void Repairer::stamp(std::span<const TetId> tets) {
+  ++clock_;
+  if (vert_stamp_.size() < m_.coords.size()) vert_stamp_.resize(m_.coords.size(), 0);
+  for (TetId t : tets)
+    for (VertId v : m_.tet2verts[t]) vert_stamp_[v] = clock_;
+}
+
+bool Repairer::unchanged_since_failure(TetId t) const {
+  if (t >= failed_at_.size() || failed_at_[t] == 0) return false;
+  for (VertId v : m_.tet2verts[t])
+    if (v < vert_stamp_.size() && vert_stamp_[v] >= failed_at_[t]) return false;
+  return true;
+}
+
+void Repairer::note_failure(TetId t) {
+  if (failed_at_.size() <= t) failed_at_.resize(std::max<std::size_t>(t + 1, 2 * failed_at_.size()), 0);
+  // clock_ + 1: an edit after this one has a stamp >= it.
+  failed_at_[t] = clock_ + 1;
+}
 
 TetId Repairer::find_tet_with(VertId a, VertId b) const {
   if (a >= m_.vert2tet.size() || m_.vert2tet[a] == kNone) return kNone;
@@ -271,22 +306,27 @@ void Repairer::before_edit(std::span<const TetId> old) {
   }
 }
 
-void Repairer::refresh_edge(VertId a, VertId b, TetId t) {
+bool Repairer::refresh_edge(VertId a, VertId b, TetId t) {
+  std::array<Vec3, mesh::kMaxOrder> old;
+  const bool had = m_.high_order.get_edge(a, b, old.data());
   const mesh::ModelRef on = edge_entity(a, b, t);
   if (on.dim == 3) {
-    m_.high_order.erase_edge(a, b);
-    return;
+    if (had) m_.high_order.erase_edge(a, b);
+    return had;
   }
   std::array<Vec3, mesh::kMaxOrder> nodes;
   placer_.edge_nodes(a, b, on, nodes.data());
   m_.high_order.set_edge(a, b, std::span<const Vec3>(nodes.data(), order_ - 1));
+  return !had || !std::equal(nodes.begin(), nodes.begin() + (order_ - 1), old.begin());
 }
 
-void Repairer::refresh_face(VertId a, VertId b, VertId c) {
+bool Repairer::refresh_face(VertId a, VertId b, VertId c) {
+  Vec3 old;
+  const bool had = m_.high_order.get_face(a, b, c, &old);
   const Index i = boundary_.find_tri(a, b, c);
   if (i == kNone) {
-    m_.high_order.erase_face(a, b, c);
-    return;
+    if (had) m_.high_order.erase_face(a, b, c);
+    return had;
   }
   std::array<std::array<Vec3, 2>, 3> e{};
   const std::array<VertId, 3> v{a, b, c};
@@ -294,9 +334,17 @@ void Repairer::refresh_face(VertId a, VertId b, VertId c) {
   Vec3 centre;
   placer_.face_nodes(a, b, c, m_.tris[i].face_tag, e[0].data(), e[1].data(), e[2].data(), &centre);
   m_.high_order.set_face(a, b, c, std::span<const Vec3>(&centre, 1));
+  return !had || centre != old;
+}
+
+void Repairer::recheck_face(VertId a, VertId b, VertId c) {
+  if (const TetId t = find_tet_with(a, b); t != kNone)
+    for (TetId s : mesh::collect_shell(m_, a, b, t).tets)
+      if (mesh::local_index(m_, s, c) >= 0) created_.push_back(s);
 }
 
 void Repairer::after_edit(std::span<const TetId> created) {
+  const std::size_t first = created_.size();
   created_.insert(created_.end(), created.begin(), created.end());
   std::vector<std::uint64_t> seen;
   for (TetId t : created) {
@@ -305,7 +353,12 @@ void Repairer::after_edit(std::span<const TetId> created) {
       const std::uint64_t k = edge_key(v[e[0]], v[e[1]]);
       if (std::find(seen.begin(), seen.end(), k) != seen.end()) continue;
       seen.push_back(k);
-      refresh_edge(v[e[0]], v[e[1]], t);
+      // An edge on the cavity's hull is shared with tets outside it, which
+      // change with its nodes.
+      if (refresh_edge(v[e[0]], v[e[1]], t)) {
+        const mesh::Shell shell = mesh::collect_shell(m_, v[e[0]], v[e[1]], t);
+        created_.insert(created_.end(), shell.tets.begin(), shell.tets.end());
+      }
     }
   }
   // Entities of the old tets that are in no new one: gone, or kept by tets
@@ -329,19 +382,19 @@ void Repairer::after_edit(std::span<const TetId> created) {
   if (order_ >= 3) {
     for (TetId t : created) {
       const auto& v = m_.tet2verts[t];
-      for (const auto& f : mesh::kFaceVerts) refresh_face(v[f[0]], v[f[1]], v[f[2]]);
+      for (const auto& f : mesh::kFaceVerts)
+        if (refresh_face(v[f[0]], v[f[1]], v[f[2]])) recheck_face(v[f[0]], v[f[1]], v[f[2]]);
     }
     for (const auto& f : old_faces_) {
       refresh_face(f[0], f[1], f[2]);
       // A face kept by a tet outside the cavity: that tet is checked again.
       if (boundary_.find_tri(f[0], f[1], f[2]) == kNone) continue;
-      if (const TetId t = find_tet_with(f[0], f[1]); t != kNone)
-        for (TetId s : mesh::collect_shell(m_, f[0], f[1], t).tets)
-          if (mesh::local_index(m_, s, f[2]) >= 0) created_.push_back(s);
+      recheck_face(f[0], f[1], f[2]);
     }
   }
   old_edges_.clear();
   old_faces_.clear();
+  stamp(std::span<const TetId>(created_).subspan(first));
 }
 
 // --- problem entities ----------------------------------------------------------
@@ -827,6 +880,7 @@ void Repairer::curve_interior(TetId t) {
     if (improves(current, before)) {
       set(offset);
       interior_curved_.insert(edge_key(a, b));
+      touched_.insert(touched_.end(), shell.tets.begin(), shell.tets.end());
     } else {
       m_.high_order.erase_edge(a, b);
     }
@@ -889,9 +943,12 @@ RepairStats Repairer::run(std::span<const TetId> unacceptable) {
       const ElementCheck c = check(m_.tet2verts[t]);
       if (c.acceptable) continue;
       if (st_.passes == 0) note_problem(t, c);
+      if (unchanged_since_failure(t)) continue;
       if (retriangulate(t) || delete_element(t) || remesh(t) || reposition(t)) {
         ++changes;
         ++ops;
+      } else {
+        note_failure(t);
       }
     }
     // The list, updated: the old entries still unacceptable and the tets
@@ -913,11 +970,15 @@ RepairStats Repairer::run(std::span<const TetId> unacceptable) {
       if (!ed_.is_dead(t) && !acceptable(t)) curve_interior(t);
     // Curving an edge moves the nodes of its whole shell: a shell is taken
     // when it has fewer unacceptable tets, not only the ones listed, so the
-    // list is made again.
-    if (!interior_curved_.empty()) {
-      ed_.compact();
-      bad = check_mesh(m_, o_.acceptance, false).unacceptable;
-    }
+    // list is made again from the listed and the touched tets.
+    std::vector<TetId> next;
+    for (TetId t : bad)
+      if (!ed_.is_dead(t) && !acceptable(t)) next.push_back(t);
+    for (TetId t : touched_)
+      if (!ed_.is_dead(t) && !acceptable(t)) next.push_back(t);
+    std::sort(next.begin(), next.end());
+    next.erase(std::unique(next.begin(), next.end()), next.end());
+    bad = std::move(next);
   }
   if (o_.straighten) straighten(bad);
   // What is left of them: straightening takes back interior curving first.
