@@ -14,6 +14,7 @@
 #include "curvemesh/size/build.hpp"
 #include "curvemesh/generate/boundary_check.hpp"
 #include "curvemesh/generate/boundary_mesh.hpp"
+#include "curvemesh/generate/edge_mesh.hpp"
 
 using namespace cm;
 
@@ -74,6 +75,57 @@ TEST(EdgeMesh, CircleGetsEqualSegmentsFromTheIntegral) {
   // A closed edge never has fewer than three segments.
   const size::UniformSizeField huge(100);
   EXPECT_EQ(generate::discretize_edge(*cyl, circle, huge, {}, 3).params.size(), 4u);
+}
+
+// At a cusp the first segment gets kCuspStretch times the others' length,
+// the count unchanged.
+TEST(EdgeMesh, CuspEndsGetALongerSegment) {
+  const auto cyl = geom::make_analytic_cylinder(Vec3::Zero(), Vec3::UnitZ(), 2, 1);
+  const size::UniformSizeField h(0.1);
+  int circle = 0;
+  for (int e = 1; e <= cyl->count(1); ++e)
+    if (cyl->type({1, e}) == geom::ShapeType::kCircle) circle = e;
+  ASSERT_GT(circle, 0);
+  const auto plain = generate::discretize_edge(*cyl, circle, h, {});
+  const auto one = generate::discretize_edge(*cyl, circle, h, {}, 1, {true, false});
+  const auto both = generate::discretize_edge(*cyl, circle, h, {}, 1, {true, true});
+  ASSERT_EQ(one.params.size(), plain.params.size());
+  ASSERT_EQ(both.params.size(), plain.params.size());
+  const auto arc = [](const generate::EdgeMesh& m, std::size_t k) { return m.params[k + 1] - m.params[k]; };
+  const std::size_t n = plain.params.size() - 1;
+  EXPECT_NEAR(arc(one, 0) / arc(one, 1), generate::kCuspStretch, 1e-3);
+  EXPECT_NEAR(arc(one, n - 1) / arc(one, 1), 1, 1e-3);
+  EXPECT_NEAR(arc(both, 0) / arc(both, n / 2), generate::kCuspStretch, 1e-3);
+  EXPECT_NEAR(arc(both, n - 1) / arc(both, n / 2), generate::kCuspStretch, 1e-3);
+  // No two edges of a cylinder leave a vertex in the same direction.
+  for (const auto& ends : generate::cusp_ends(*cyl)) EXPECT_FALSE(ends[0] || ends[1]);
+}
+
+// The ends cusp_ends marks come in pairs: two edges leaving one vertex at
+// less than kCuspDegrees (t20_data.step has faces tapering to a point).
+TEST(EdgeMesh, CuspsArePairsOfTangentEdgesAtAVertex) {
+  const auto m = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/t20_data.step");
+  const auto cusps = generate::cusp_ends(*m);
+  ASSERT_EQ(static_cast<int>(cusps.size()), m->count(1));
+  const auto direction = [&](int e, int side) {
+    const geom::ParamRange r = m->param_range({1, e});
+    return Vec3(m->edge_derivatives(e, side == 0 ? r.u0 : r.u1).d1.normalized() * (side == 0 ? 1.0 : -1.0));
+  };
+  int marked = 0;
+  for (int e = 1; e <= m->count(1); ++e)
+    for (int side = 0; side < 2; ++side) {
+      if (!cusps[e - 1][side]) continue;
+      ++marked;
+      const int v = m->edge_vertices(e)[side];
+      bool partner = false;
+      for (int f = 1; f <= m->count(1); ++f)
+        for (int fs = 0; fs < 2; ++fs)
+          if ((f != e || fs != side) && m->edge_vertices(f)[fs] == v && cusps[f - 1][fs] &&
+              direction(e, side).dot(direction(f, fs)) > std::cos(generate::kCuspDegrees * std::numbers::pi / 180))
+            partner = true;
+      EXPECT_TRUE(partner) << "edge " << e << " end " << side;
+    }
+  EXPECT_GE(marked, 2);
 }
 
 TEST(BoundaryMesh, AnalyticShapesAreClosedValidAndWellShaped) {

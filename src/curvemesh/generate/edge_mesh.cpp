@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 
 #include <tbb/parallel_for.h>
 
@@ -65,7 +66,7 @@ Table integrate(const geom::Model& m, int edge, const size::SizeField& size, dou
 }  // namespace
 
 EdgeMesh discretize_edge(const geom::Model& m, int edge, const size::SizeField& size, const EdgeMeshOptions& o,
-                         int min_segments) {
+                         int min_segments, std::array<bool, 2> cusp) {
   EdgeMesh out;
   out.edge = edge;
   out.vertices = m.edge_vertices(edge);
@@ -86,9 +87,17 @@ EdgeMesh discretize_edge(const geom::Model& m, int edge, const size::SizeField& 
   out.params.resize(n + 1);
   out.params.front() = r.u0;
   out.params.back() = r.u1;
+  // Segment i spans the metric length L·(weights before i + its own)/total.
+  double first = 1, last = 1;
+  if (n >= 2) {
+    first = cusp[0] ? kCuspStretch : 1;
+    last = cusp[1] ? kCuspStretch : 1;
+    if (n / (n - 2 + first + last) < 0.8) first = last = 1;
+  }
+  const double total = n - 2 + first + last;
   std::size_t k = 1;
   for (int i = 1; i < n; ++i) {
-    const double target = out.metric_length * i / n;
+    const double target = out.metric_length * (first + (i - 1)) / total;
     while (k + 1 < t.cum.size() && t.cum[k] < target) ++k;
     // Linear in the table interval [k-1, k].
     const double c0 = t.cum[k - 1], c1 = t.cum[k];
@@ -103,6 +112,35 @@ EdgeMesh discretize_edge(const geom::Model& m, int edge, const size::SizeField& 
   return out;
 }
 
+std::vector<std::array<bool, 2>> cusp_ends(const geom::Model& m) {
+  const int ne = m.count(1);
+  struct End {
+    int edge, side;
+    Vec3 direction;  // unit, leaving the vertex
+  };
+  std::vector<std::vector<End>> at(m.count(0) + 1);
+  for (int e = 1; e <= ne; ++e) {
+    if (m.is_degenerate(e)) continue;
+    const auto v = m.edge_vertices(e);
+    const geom::ParamRange r = m.param_range({1, e});
+    for (int side = 0; side < 2; ++side) {
+      if (v[side] <= 0) continue;
+      const Vec3 d = m.edge_derivatives(e, side == 0 ? r.u0 : r.u1).d1 * (side == 0 ? 1.0 : -1.0);
+      if (d.norm() > 0) at[v[side]].push_back({e, side, d.normalized()});
+    }
+  }
+  std::vector<std::array<bool, 2>> out(ne, {false, false});
+  const double cosine = std::cos(kCuspDegrees * std::numbers::pi / 180);
+  for (const auto& ends : at)
+    for (std::size_t i = 0; i < ends.size(); ++i)
+      for (std::size_t j = i + 1; j < ends.size(); ++j)
+        if (ends[i].direction.dot(ends[j].direction) > cosine) {
+          out[ends[i].edge - 1][ends[i].side] = true;
+          out[ends[j].edge - 1][ends[j].side] = true;
+        }
+  return out;
+}
+
 std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeField& size, const EdgeMeshOptions& o) {
   const int ne = m.count(1);
   // Edges joining the same two vertices need two segments each so that no
@@ -113,6 +151,7 @@ std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeFie
     const auto v = m.edge_vertices(e);
     ++joining[{std::min(v[0], v[1]), std::max(v[0], v[1])}];
   }
+  const std::vector<std::array<bool, 2>> cusps = cusp_ends(m);
   std::vector<EdgeMesh> out(ne);
   tbb::parallel_for(1, ne + 1, [&](int e) {
     const auto v = m.edge_vertices(e);
@@ -123,7 +162,7 @@ std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeFie
                it != joining.end() && it->second > 1) {
       min_segments = 2;
     }
-    out[e - 1] = discretize_edge(m, e, size, o, min_segments);
+    out[e - 1] = discretize_edge(m, e, size, o, min_segments, cusps[e - 1]);
   });
   return out;
 }

@@ -23,7 +23,10 @@
 //    kept when the ball's worst triangle does not get worse and its sum
 //    grows. Every accepted change keeps all triangles positive in (u, v) (no
 //    parametric overlap) and their normals along the surface's; triangles
-//    that fold at their centroid are flipped or split at the end.
+//    that fold at their centroid are flipped or split at the end. The same
+//    passes are also run after flips towards interior valence 6, and that
+//    more regular result is kept when its worst triangle is no worse and its
+//    mean is higher.
 // Points of a pole (several (u, v) points, one vertex) bound triangles that
 // vanish from the surface mesh; they count as neither good nor bad.
 #include <vector>
