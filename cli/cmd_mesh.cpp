@@ -19,6 +19,7 @@
 #include "curvemesh/quality/statistics.hpp"
 #include "curving.hpp"
 #include "exit_codes.hpp"
+#include "improve_report.hpp"
 #include "json_output.hpp"
 #include "size_options.hpp"
 
@@ -263,11 +264,9 @@ int run_volume(const MeshCliOptions& o) {
                st.recovery.steiner_on_edges, st.recovery.steiner_on_faces, st.recovery.surface_flips,
                st.recovery.rounds);
     if (!o.no_optimize)
-      fmt::print("optimization: {} edge removals, {} face swaps, {} relocations ({} searched), {} insertions, {} "
-                 "deletions, {} collapses in {} passes; tets with mean ratio < 0.3: {} -> {}; min {:.3f} -> {:.3f}; "
-                 "min dihedral {:.2f} -> {:.2f} deg\n",
-                 opt.edge_removals, opt.face_swaps, opt.relocations, opt.searched_relocations, opt.insertions,
-                 opt.deletions, opt.collapses, opt.passes, opt.below_before, opt.below_after, opt.min_before,
+      fmt::print("optimization: {}; tets with mean ratio < 0.3: {} -> {}; min {:.3f} -> {:.3f}; min dihedral {:.2f} -> "
+                 "{:.2f} deg\n",
+                 improve_operator_counts(opt, false), opt.below_before, opt.below_after, opt.min_before,
                  opt.min_after, opt.min_dihedral_before, opt.min_dihedral_after);
     if (curving) print_curve_report(*curving);
     fmt::print("quality{}: mean ratio min {:.3f} mean {:.3f}; min dihedral {:.2f} deg\n",

@@ -28,6 +28,7 @@
 #include "curvemesh/size/expression.hpp"
 #include "classification_report.hpp"
 #include "exit_codes.hpp"
+#include "improve_report.hpp"
 #include "json_output.hpp"
 
 namespace cm::cli {
@@ -432,12 +433,7 @@ int run_optimize(const OptimizeCliOptions& o) {
                  adapt.lengths_after.mean);
       fmt::print("{}", render_lengths(adapt.lengths_after));
     } else {
-      fmt::print("operators: {} edge removals, {} face swaps, {} relocations ({} on the boundary, {} searched), {} "
-                 "insertions, {} deletions, {} collapses in {} passes (swaps {:.2f} s, relocation {:.2f} s, insertion "
-                 "{:.2f} s, deletion {:.2f} s, collapse {:.2f} s)\n",
-                 iso.edge_removals, iso.face_swaps, iso.relocations, iso.boundary_relocations, iso.searched_relocations,
-                 iso.insertions, iso.deletions, iso.collapses, iso.passes, iso.swap_seconds, iso.relocation_seconds,
-                 iso.insertion_seconds, iso.deletion_seconds, iso.collapse_seconds);
+      fmt::print("operators: {}\n", improve_operator_counts(iso, true));
     }
     fmt::print("{}", render_limit(limit));
     fmt::print("volume: {:.10g} -> {:.10g}; boundary: {}\n", before.volume, after.volume,

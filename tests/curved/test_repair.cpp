@@ -4,12 +4,14 @@
 // ending with every element certified valid and acceptable, the mesh still
 // a geometric triangulation of its model, the node storage exactly the
 // boundary's, and the same result for any thread count.
+#include <cmath>
 #include <set>
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include "curved_support.hpp"
+#include "curvemesh/curved/detail/check_memo.hpp"
 #include "curvemesh/generate/boundary_check.hpp"
 #include "curvemesh/mesh/high_order.hpp"
 #include "curvemesh/mesh/topology.hpp"
@@ -61,6 +63,30 @@ TEST(ElementCheck, EdgeBentThroughTheOppositeFaceIsInvalidThere) {
   curved::Acceptance strict;
   strict.min_scaled_jacobian = 0.99;
   EXPECT_FALSE(curved::check_element(2, n, strict).acceptable);
+}
+
+// The repair's memo of checks gives what check_element gives, and only
+// for exactly the same nodes.
+TEST(ElementCheck, MemoAnswersOnlyForTheSameNodes) {
+  curved::detail::CheckMemo memo(2, {});
+  auto bent = straight_p2(kUnit);
+  bent[4] = Vec3(0.5, 1.2, 1.2);
+  const auto direct = curved::check_element(2, bent, {});
+  for (int round = 0; round < 2; ++round) {
+    const auto c = memo(std::vector<Vec3>(bent));
+    EXPECT_EQ(c.verdict, direct.verdict);
+    EXPECT_EQ(c.scaled_jacobian, direct.scaled_jacobian);
+    EXPECT_EQ(c.acceptable, direct.acceptable);
+  }
+  EXPECT_EQ(memo.hits(), 1u);
+  // The smallest change of one node is a new element.
+  auto moved = bent;
+  moved[4].x() = std::nextafter(moved[4].x(), 1.0);
+  memo(std::vector<Vec3>(moved));
+  EXPECT_EQ(memo.hits(), 1u);
+  EXPECT_EQ(memo.misses(), 2u);
+  const auto straight = memo(straight_p2(kUnit));
+  EXPECT_TRUE(straight.acceptable);
 }
 
 struct Case {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "curvemesh/core/predicates.hpp"
+#include "curvemesh/curved/detail/check_memo.hpp"
 #include "curvemesh/curved/element_check.hpp"
 #include "curvemesh/curved/nodes.hpp"
 #include "curvemesh/curved/repair.hpp"
@@ -143,7 +144,7 @@ class ScratchVertex {
 class Repairer {
  public:
   Repairer(mesh::TetMesh& m, const geom::Model& model, const RepairOptions& o)
-      : m_(m), model_(model), o_(o), ed_(m), boundary_(m), placer_(m, model), order_(m.high_order.order()) {
+      : m_(m), model_(model), o_(o), ed_(m), boundary_(m), placer_(m, model), order_(m.high_order.order()), memo_(order_, o.acceptance) {
     modify::mark_boundary_faces(ed_);
     ed_.set_hook([this](const mesh::TetMesh&, std::span<const TetId> created) { after_edit(created); });
   }
@@ -161,7 +162,7 @@ class Repairer {
 
  private:
   ElementCheck check(const Verts& v) const {
-    return check_element(order_, mesh::gather_tet_nodes(m_, v), o_.acceptance);
+    return memo_(mesh::gather_tet_nodes(m_, v));
   }
   Outcome evaluate(std::span<const Verts> tets) const {
     Outcome out;
@@ -226,6 +227,7 @@ class Repairer {
   modify::Cavity cav_;
   NodePlacer placer_;
   int order_;
+  mutable CheckMemo memo_;
   RepairStats st_;
   std::size_t budget_ = 0;
   // Entities of the tets being replaced (before_edit).

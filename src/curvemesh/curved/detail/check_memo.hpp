@@ -1,0 +1,60 @@
+#pragma once
+// check_element is a pure function of a tet's nodes (and the order and the
+// acceptance, fixed for a run). The repair judges the same tets over and
+// over: the "before" of every candidate around a tet, the ring tets of the
+// edge-removal dynamic program for each of a tet's edges, the same
+// candidates again on the next pass. Results are remembered keyed by the
+// nodes themselves, compared exactly, so a temporary node override, a
+// scratch vertex reusing an id or a moved vertex can never hit a stale one.
+#include <bit>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "curvemesh/curved/element_check.hpp"
+
+namespace cm::curved::detail {
+
+class CheckMemo {
+ public:
+  CheckMemo(int order, const Acceptance& acceptance) : order_(order), acceptance_(acceptance) {}
+
+  ElementCheck operator()(std::vector<Vec3>&& nodes) {
+    const std::uint64_t key = hash(nodes);
+    if (const auto it = memo_.find(key); it != memo_.end() && it->second.nodes == nodes) {
+      ++hits_;
+      return it->second.result;
+    }
+    ++misses_;
+    const ElementCheck c = check_element(order_, nodes, acceptance_);
+    // A bounded memory: start afresh rather than track ages.
+    if (memo_.size() >= kMaxEntries) memo_.clear();
+    memo_[key] = {std::move(nodes), c};
+    return c;
+  }
+  std::size_t hits() const { return hits_; }
+  std::size_t misses() const { return misses_; }
+
+ private:
+  static constexpr std::size_t kMaxEntries = 1 << 18;
+  struct Entry {
+    std::vector<Vec3> nodes;
+    ElementCheck result;
+  };
+  static std::uint64_t hash(const std::vector<Vec3>& nodes) {
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    for (const Vec3& p : nodes)
+      for (int i = 0; i < 3; ++i) {
+        h ^= std::bit_cast<std::uint64_t>(p[i]);
+        h *= 0x100000001b3ull;
+        h ^= h >> 29;
+      }
+    return h;
+  }
+  int order_;
+  Acceptance acceptance_;
+  std::unordered_map<std::uint64_t, Entry> memo_;
+  std::size_t hits_ = 0, misses_ = 0;
+};
+
+}  // namespace cm::curved::detail
