@@ -12,6 +12,7 @@
 
 #include "curved_support.hpp"
 #include "curvemesh/curved/detail/check_memo.hpp"
+#include "curvemesh/curved/nodes.hpp"
 #include "curvemesh/generate/boundary_check.hpp"
 #include "curvemesh/mesh/high_order.hpp"
 #include "curvemesh/mesh/topology.hpp"
@@ -87,6 +88,34 @@ TEST(ElementCheck, MemoAnswersOnlyForTheSameNodes) {
   EXPECT_EQ(memo.misses(), 2u);
   const auto straight = memo(straight_p2(kUnit));
   EXPECT_TRUE(straight.acceptable);
+}
+
+// check_mesh again with the first one's cache gives what a fresh check
+// gives, after a node moved too.
+TEST(ElementCheck, RecheckWithTheCacheEqualsAFreshCheck) {
+  Meshed r = mesh_for_curving("builtin:torus", 0.25);
+  curved::place_boundary_nodes(r.m, *r.model, 2);
+  const curved::Acceptance acc;
+  curved::CheckCache cache;
+  const auto first = curved::check_mesh(r.m, acc, true, nullptr, &cache);
+  ASSERT_GT(cache.checks.size(), 0u);
+  const auto same = [](const curved::MeshCheck& a, const curved::MeshCheck& b) {
+    EXPECT_EQ(a.invalid, b.invalid);
+    EXPECT_EQ(a.unacceptable, b.unacceptable);
+    EXPECT_EQ(a.min_scaled_jacobian, b.min_scaled_jacobian);
+    EXPECT_EQ(a.mean_scaled_jacobian, b.mean_scaled_jacobian);
+    EXPECT_EQ(a.min_measure, b.min_measure);
+    EXPECT_EQ(a.mean_measure, b.mean_measure);
+  };
+  same(curved::check_mesh(r.m, acc, true, &cache), first);
+  // Push one boundary edge's node through its tets.
+  const auto& t = r.m.tris.front();
+  const VertId a = t.verts[0], b = t.verts[1];
+  const Vec3 far = 0.5 * (r.m.coords[a] + r.m.coords[b]) + 3 * (r.m.coords[t.verts[2]] - r.m.coords[a]);
+  r.m.high_order.set_edge(a, b, std::span<const Vec3>(&far, 1));
+  const auto fresh = curved::check_mesh(r.m, acc, true);
+  EXPECT_GT(fresh.unacceptable.size(), first.unacceptable.size());
+  same(curved::check_mesh(r.m, acc, true, &cache), fresh);
 }
 
 struct Case {

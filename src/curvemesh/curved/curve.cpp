@@ -80,8 +80,10 @@ CurveReport curve_mesh(mesh::TetMesh& m, const geom::Model& model, const CurveOp
   r.placement = place_boundary_nodes(m, model, o.order);
   r.place_seconds = step.seconds();
   step.reset();
-  // Before: what to repair (I only where it decides); after: the report.
-  const MeshCheck before = check_mesh(m, o.repair.acceptance, false);
+  // Before: what to repair, with exact measures so that the report after
+  // the repair redoes only the tets whose nodes it changed.
+  CheckCache seen;
+  const MeshCheck before = check_mesh(m, o.repair.acceptance, true, nullptr, &seen);
   r.invalid_before = before.invalid.size();
   r.unacceptable_before = before.unacceptable.size();
   r.min_scaled_jacobian_before = before.min_scaled_jacobian;
@@ -94,7 +96,7 @@ CurveReport curve_mesh(mesh::TetMesh& m, const geom::Model& model, const CurveOp
     mesh::drop_unused_vertices(m);
   }
   step.reset();
-  r.after = check_mesh(m, o.repair.acceptance);
+  r.after = check_mesh(m, o.repair.acceptance, true, &seen);
   r.check_seconds += step.seconds();
   step.reset();
   r.error_straight = measure_geometric_error(m, model, true);

@@ -1,5 +1,8 @@
 #include "curvemesh/curved/element_check.hpp"
 
+#include <algorithm>
+#include <bit>
+
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
@@ -79,26 +82,94 @@ ElementCheck check_element(int order, std::span<const Vec3> nodes, const Accepta
   return c;
 }
 
-ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& acceptance, bool exact_measure) {
-  // Most tets have at most one vertex on the boundary, hence no boundary
-  // edge and no nodes: straight, decided by orient3d alone.
+std::uint64_t hash_nodes(std::span<const Vec3> nodes) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (const Vec3& p : nodes)
+    for (int i = 0; i < 3; ++i) {
+      h ^= std::bit_cast<std::uint64_t>(p[i]);
+      h *= 0x100000001b3ull;
+      h ^= h >> 29;
+    }
+  return h;
+}
+
+const ElementCheck* CheckCache::find(std::span<const Vec3> tet_nodes) const {
+  if (tet_nodes.size() != nodes_per_tet) return nullptr;
+  const auto it = by_hash.find(hash_nodes(tet_nodes));
+  if (it == by_hash.end()) return nullptr;
+  const Vec3* stored = &nodes[std::size_t(it->second) * nodes_per_tet];
+  return std::equal(tet_nodes.begin(), tet_nodes.end(), stored) ? &checks[it->second] : nullptr;
+}
+
+namespace {
+
+// Most tets have at most one vertex on the boundary, hence no boundary
+// edge and no nodes: straight, decided by orient3d alone.
+bool plainly_straight(const mesh::TetMesh& m, TetId t) {
+  if (m.high_order.order() <= 1) return true;
   const auto& v = m.tet2verts[t];
   int on_boundary = 0;
   for (VertId x : v) on_boundary += x < m.vert_class.size() && m.vert_class[x].dim < 3;
-  if (on_boundary < 2 && m.high_order.order() > 1) {
-    const std::array<Vec3, 4> corners{m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]};
-    if (m.high_order.num_edges() == 0 || !has_any_node(m, v)) return check_element(1, corners, acceptance);
-  }
+  return on_boundary < 2 && (m.high_order.num_edges() == 0 || !has_any_node(m, v));
+}
+
+ElementCheck check_straight(const mesh::TetMesh& m, TetId t, const Acceptance& acceptance) {
+  const auto& v = m.tet2verts[t];
+  const std::array<Vec3, 4> corners{m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]};
+  return check_element(1, corners, acceptance);
+}
+
+}  // namespace
+
+ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& acceptance, bool exact_measure) {
+  if (plainly_straight(m, t)) return check_straight(m, t, acceptance);
   return check_element(m.high_order.order(), mesh::gather_tet_nodes(m, t), acceptance, exact_measure);
 }
 
-MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures) {
+MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures,
+                     const CheckCache* reuse, CheckCache* keep) {
   const std::size_t nt = m.num_tets();
+  const int order = m.high_order.order();
+  const std::size_t per_tet = order >= 1 ? std::size_t((order + 1) * (order + 2) * (order + 3) / 6) : 4;
+  if (reuse && (reuse->order != order || reuse->nodes_per_tet != per_tet)) reuse = nullptr;
+  // Curved tets get consecutive entries in `keep`, in tet order.
+  std::vector<std::uint32_t> entry(nt + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) entry[t + 1] = !plainly_straight(m, static_cast<TetId>(t));
+  });
+  for (std::size_t t = 0; t < nt; ++t) entry[t + 1] += entry[t];
+  if (keep) {
+    *keep = CheckCache{};
+    keep->order = order;
+    keep->nodes_per_tet = per_tet;
+    keep->nodes.resize(std::size_t(entry[nt]) * per_tet);
+    keep->checks.resize(entry[nt]);
+  }
   std::vector<ElementCheck> checks(nt);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 256), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t)
-      checks[t] = check_tet(m, static_cast<TetId>(t), acceptance, exact_measures);
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      const auto tet = static_cast<TetId>(t);
+      if (entry[t + 1] == entry[t]) {
+        checks[t] = check_straight(m, tet, acceptance);
+        continue;
+      }
+      const std::vector<Vec3> nodes = mesh::gather_tet_nodes(m, tet);
+      const ElementCheck* known = reuse ? reuse->find(nodes) : nullptr;
+      if (known && (known->measure_exact || !exact_measures))
+        checks[t] = *known;
+      else
+        checks[t] = check_element(order, nodes, acceptance, exact_measures);
+      if (keep) {
+        std::copy(nodes.begin(), nodes.end(), keep->nodes.begin() + std::ptrdiff_t(std::size_t(entry[t]) * per_tet));
+        keep->checks[entry[t]] = checks[t];
+      }
+    }
   });
+  if (keep) {
+    keep->by_hash.reserve(keep->checks.size());
+    for (std::uint32_t k = 0; k < keep->checks.size(); ++k)
+      keep->by_hash.emplace(hash_nodes(std::span<const Vec3>(&keep->nodes[std::size_t(k) * per_tet], per_tet)), k);
+  }
   MeshCheck out;
   double sum_sj = 0, sum_i = 0;
   for (std::size_t t = 0; t < nt; ++t) {

@@ -18,7 +18,9 @@
 // about what Gmsh's high-order optimizer aims for). I samples, the scaled
 // Jacobian bound certifies: I alone called Gmsh's folded P2 tets on the
 // shared torus acceptable (I = 0.52 for one whose det J changes sign).
+#include <cstdint>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 #include "curvemesh/mesh/tet_mesh.hpp"
@@ -72,8 +74,29 @@ struct MeshCheck {
   double min_scaled_jacobian = 1, mean_scaled_jacobian = 1;
   double min_measure = 1, mean_measure = 1;
 };
+/// What a check_mesh saw of the tets that have nodes off the straight tet:
+/// their nodes and results, so that checking the mesh again after a few
+/// local changes (the repair) redoes only the tets whose nodes changed. A
+/// tet is matched by its nodes, compared exactly, never by its id.
+struct CheckCache {
+  int order = 0;
+  std::size_t nodes_per_tet = 0;
+  std::vector<Vec3> nodes;  ///< nodes_per_tet per entry
+  std::vector<ElementCheck> checks;
+  std::unordered_map<std::uint64_t, std::uint32_t> by_hash;  ///< first entry with those nodes' hash
+  /// The entry whose nodes are exactly these, if any.
+  const ElementCheck* find(std::span<const Vec3> tet_nodes) const;
+};
+
 /// With `exact_measures` false the measure statistics are lower bounds
 /// (see check_element); the verdicts and lists are the same either way.
-MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures = true);
+/// With `reuse`, results of tets found there are taken as they are (only
+/// those computed with exact measures, when exact_measures is asked);
+/// with `keep`, the curved tets' nodes and results are stored there.
+MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures = true,
+                     const CheckCache* reuse = nullptr, CheckCache* keep = nullptr);
+
+/// A hash of node coordinates (their bits), for exact-match tables.
+std::uint64_t hash_nodes(std::span<const Vec3> nodes);
 
 }  // namespace cm::curved

@@ -6,7 +6,6 @@
 // candidates again on the next pass. Results are remembered keyed by the
 // nodes themselves, compared exactly, so a temporary node override, a
 // scratch vertex reusing an id or a moved vertex can never hit a stale one.
-#include <bit>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -20,7 +19,7 @@ class CheckMemo {
   CheckMemo(int order, const Acceptance& acceptance) : order_(order), acceptance_(acceptance) {}
 
   ElementCheck operator()(std::vector<Vec3>&& nodes) {
-    const std::uint64_t key = hash(nodes);
+    const std::uint64_t key = hash_nodes(nodes);
     if (const auto it = memo_.find(key); it != memo_.end() && it->second.nodes == nodes) {
       ++hits_;
       return it->second.result;
@@ -41,16 +40,6 @@ class CheckMemo {
     std::vector<Vec3> nodes;
     ElementCheck result;
   };
-  static std::uint64_t hash(const std::vector<Vec3>& nodes) {
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    for (const Vec3& p : nodes)
-      for (int i = 0; i < 3; ++i) {
-        h ^= std::bit_cast<std::uint64_t>(p[i]);
-        h *= 0x100000001b3ull;
-        h ^= h >> 29;
-      }
-    return h;
-  }
   int order_;
   Acceptance acceptance_;
   std::unordered_map<std::uint64_t, Entry> memo_;
