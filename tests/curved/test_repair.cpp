@@ -98,7 +98,7 @@ TEST(ElementCheck, RecheckWithTheCacheEqualsAFreshCheck) {
   const curved::Acceptance acc;
   curved::CheckCache cache;
   const auto first = curved::check_mesh(r.m, acc, true, nullptr, &cache);
-  ASSERT_GT(cache.checks.size(), 0u);
+  ASSERT_GT(cache.size(), 0u);
   const auto same = [](const curved::MeshCheck& a, const curved::MeshCheck& b) {
     EXPECT_EQ(a.invalid, b.invalid);
     EXPECT_EQ(a.unacceptable, b.unacceptable);

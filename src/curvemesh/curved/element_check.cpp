@@ -82,6 +82,12 @@ ElementCheck check_element(int order, std::span<const Vec3> nodes, const Accepta
   return c;
 }
 
+namespace {
+
+std::size_t nodes_per_tet(int order) {
+  return order >= 1 ? std::size_t((order + 1) * (order + 2) * (order + 3) / 6) : 4;
+}
+
 std::uint64_t hash_nodes(std::span<const Vec3> nodes) {
   std::uint64_t h = 0xcbf29ce484222325ull;
   for (const Vec3& p : nodes)
@@ -93,12 +99,36 @@ std::uint64_t hash_nodes(std::span<const Vec3> nodes) {
   return h;
 }
 
+}  // namespace
+
+CheckCache::CheckCache(int order) : order_(order), per_tet_(nodes_per_tet(order)) {}
+
 const ElementCheck* CheckCache::find(std::span<const Vec3> tet_nodes) const {
-  if (tet_nodes.size() != nodes_per_tet) return nullptr;
-  const auto it = by_hash.find(hash_nodes(tet_nodes));
-  if (it == by_hash.end()) return nullptr;
-  const Vec3* stored = &nodes[std::size_t(it->second) * nodes_per_tet];
-  return std::equal(tet_nodes.begin(), tet_nodes.end(), stored) ? &checks[it->second] : nullptr;
+  if (tet_nodes.size() != per_tet_) return nullptr;
+  const auto it = by_hash_.find(hash_nodes(tet_nodes));
+  if (it == by_hash_.end()) return nullptr;
+  const Vec3* stored = &nodes_[std::size_t(it->second) * per_tet_];
+  return std::equal(tet_nodes.begin(), tet_nodes.end(), stored) ? &checks_[it->second] : nullptr;
+}
+
+void CheckCache::add(std::span<const Vec3> tet_nodes, const ElementCheck& c) {
+  if (tet_nodes.size() != per_tet_) return;
+  by_hash_.emplace(hash_nodes(tet_nodes), static_cast<std::uint32_t>(checks_.size()));
+  nodes_.insert(nodes_.end(), tet_nodes.begin(), tet_nodes.end());
+  checks_.push_back(c);
+}
+
+void CheckCache::clear() {
+  nodes_.clear();
+  checks_.clear();
+  by_hash_.clear();
+}
+
+void CheckCache::index_all() {
+  by_hash_.clear();
+  by_hash_.reserve(checks_.size());
+  for (std::uint32_t k = 0; k < checks_.size(); ++k)
+    by_hash_.emplace(hash_nodes(std::span<const Vec3>(&nodes_[std::size_t(k) * per_tet_], per_tet_)), k);
 }
 
 namespace {
@@ -130,8 +160,8 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
                      const CheckCache* reuse, CheckCache* keep) {
   const std::size_t nt = m.num_tets();
   const int order = m.high_order.order();
-  const std::size_t per_tet = order >= 1 ? std::size_t((order + 1) * (order + 2) * (order + 3) / 6) : 4;
-  if (reuse && (reuse->order != order || reuse->nodes_per_tet != per_tet)) reuse = nullptr;
+  const std::size_t per_tet = nodes_per_tet(order);
+  if (reuse && reuse->order() != order) reuse = nullptr;
   // Curved tets get consecutive entries in `keep`, in tet order.
   std::vector<std::uint32_t> entry(nt + 1, 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -139,11 +169,10 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
   });
   for (std::size_t t = 0; t < nt; ++t) entry[t + 1] += entry[t];
   if (keep) {
-    *keep = CheckCache{};
-    keep->order = order;
-    keep->nodes_per_tet = per_tet;
-    keep->nodes.resize(std::size_t(entry[nt]) * per_tet);
-    keep->checks.resize(entry[nt]);
+    // Filled in place by the parallel loop, indexed after it.
+    *keep = CheckCache(order);
+    keep->nodes_.resize(std::size_t(entry[nt]) * per_tet);
+    keep->checks_.resize(entry[nt]);
   }
   std::vector<ElementCheck> checks(nt);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 256), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -160,16 +189,12 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
       else
         checks[t] = check_element(order, nodes, acceptance, exact_measures);
       if (keep) {
-        std::copy(nodes.begin(), nodes.end(), keep->nodes.begin() + std::ptrdiff_t(std::size_t(entry[t]) * per_tet));
-        keep->checks[entry[t]] = checks[t];
+        std::copy(nodes.begin(), nodes.end(), keep->nodes_.begin() + std::ptrdiff_t(std::size_t(entry[t]) * per_tet));
+        keep->checks_[entry[t]] = checks[t];
       }
     }
   });
-  if (keep) {
-    keep->by_hash.reserve(keep->checks.size());
-    for (std::uint32_t k = 0; k < keep->checks.size(); ++k)
-      keep->by_hash.emplace(hash_nodes(std::span<const Vec3>(&keep->nodes[std::size_t(k) * per_tet], per_tet)), k);
-  }
+  if (keep) keep->index_all();
   MeshCheck out;
   double sum_sj = 0, sum_i = 0;
   for (std::size_t t = 0; t < nt; ++t) {

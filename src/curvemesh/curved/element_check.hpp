@@ -74,18 +74,36 @@ struct MeshCheck {
   double min_scaled_jacobian = 1, mean_scaled_jacobian = 1;
   double min_measure = 1, mean_measure = 1;
 };
-/// What a check_mesh saw of the tets that have nodes off the straight tet:
-/// their nodes and results, so that checking the mesh again after a few
-/// local changes (the repair) redoes only the tets whose nodes changed. A
-/// tet is matched by its nodes, compared exactly, never by its id.
-struct CheckCache {
-  int order = 0;
-  std::size_t nodes_per_tet = 0;
-  std::vector<Vec3> nodes;  ///< nodes_per_tet per entry
-  std::vector<ElementCheck> checks;
-  std::unordered_map<std::uint64_t, std::uint32_t> by_hash;  ///< first entry with those nodes' hash
-  /// The entry whose nodes are exactly these, if any.
+class CheckCache;
+MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures,
+                     const CheckCache* reuse, CheckCache* keep);
+
+/// Check results keyed by the tet's nodes, compared exactly (never by tet
+/// id, so a moved vertex or a reused id cannot hit a stale result). A
+/// check_mesh fills one with what it saw of the tets whose nodes are off
+/// the straight tet, so that checking the mesh again after a few local
+/// changes (the repair) redoes only the tets whose nodes changed; the
+/// repair uses one as a memo of the candidates it judges again and again.
+class CheckCache {
+ public:
+  CheckCache() = default;
+  explicit CheckCache(int order);
+  int order() const { return order_; }
+  std::size_t size() const { return checks_.size(); }
+  /// The result stored for exactly these nodes, if any.
   const ElementCheck* find(std::span<const Vec3> tet_nodes) const;
+  /// Stores a result (the first one stays where nodes repeat).
+  void add(std::span<const Vec3> tet_nodes, const ElementCheck& c);
+  void clear();
+
+ private:
+  friend MeshCheck check_mesh(const mesh::TetMesh&, const Acceptance&, bool, const CheckCache*, CheckCache*);
+  void index_all();
+  int order_ = 0;
+  std::size_t per_tet_ = 0;
+  std::vector<Vec3> nodes_;  // per_tet_ per entry
+  std::vector<ElementCheck> checks_;
+  std::unordered_map<std::uint64_t, std::uint32_t> by_hash_;  // first entry with that hash
 };
 
 /// With `exact_measures` false the measure statistics are lower bounds
@@ -95,8 +113,5 @@ struct CheckCache {
 /// with `keep`, the curved tets' nodes and results are stored there.
 MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures = true,
                      const CheckCache* reuse = nullptr, CheckCache* keep = nullptr);
-
-/// A hash of node coordinates (their bits), for exact-match tables.
-std::uint64_t hash_nodes(std::span<const Vec3> nodes);
 
 }  // namespace cm::curved

@@ -501,7 +501,13 @@ class FaceMesher {
     return quality::triangle_mean_ratio(xyz_[a], xyz_[b], xyz_[c]);
   }
 
-  int flip_pass() {
+  // One sweep over the unconstrained edges, each seen once from its
+  // lower-numbered triangle: edge b-c of t = (a, b, c) and
+  // u = (d, c, b) is flipped to (a, b, d), (d, c, a) when decide(a, b, c, d)
+  // says so (decide may record the flip it accepts). Each triangle flips at
+  // most once per sweep; its other edges are seen on the next one.
+  template <class Decide>
+  int flip_where(Decide decide) {
     int flips = 0;
     for (std::size_t t = 0; t < t_.tris.size(); ++t) {
       if (!alive(t)) continue;
@@ -511,13 +517,10 @@ class FaceMesher {
         const auto tv = t_.tris[t];
         const int a = tv[i], b = tv[Triangulation2d::next(i)], c = tv[Triangulation2d::prev(i)];
         const int d = t_.tris[u][t_.mirror(static_cast<int>(t), i)];
-        // t = (a, b, c) and u = (d, c, b) share b–c; flipped: (a, b, d), (d, c, a).
-        const double before = std::min(quality(a, b, c), quality(d, c, b));
-        const double after = std::min(quality(a, b, d), quality(d, c, a));
-        if (after > 0 && after > before + 1e-6 * std::abs(before) + 1e-12) {
+        if (decide(a, b, c, d)) {
           t_.flip(static_cast<int>(t), i);
           ++flips;
-          break;  // t changed; its other edges are seen next pass
+          break;
         }
       }
     }
@@ -525,15 +528,15 @@ class FaceMesher {
     return flips;
   }
 
-  // Moves each interior vertex towards the mean of the apexes of the
-  // equilateral triangles standing on the edges of its ball, built in 3D in
-  // the tangent plane at the vertex and taken back to the plane through the
-  // tangent map (least squares), which evens out shapes and edge lengths
-  // whatever the parametrization does. A move is kept when no triangle of
-  // the ball folds, its worst one does not get worse and the sum of
-  // qualities grows; balls with a poor triangle (or where that fails) take
-  // whichever of that point, the plain centroid of the neighbours and the
-  // halfway points raises their worst triangle most.
+  // Flips for the pair's worst triangle.
+  int flip_pass() {
+    return flip_where([&](int a, int b, int c, int d) {
+      const double before = std::min(quality(a, b, c), quality(d, c, b));
+      const double after = std::min(quality(a, b, d), quality(d, c, a));
+      return after > 0 && after > before + 1e-6 * std::abs(before) + 1e-12;
+    });
+  }
+
   // The vertex state the optimization changes (the size h_ it does not).
   struct State {
     Triangulation2d t;
@@ -602,32 +605,29 @@ class FaceMesher {
         for (const int v : t_.tris[t]) ++val[v];
     const auto nb = static_cast<int>(out_.num_boundary);
     const auto dev = [&](int v, int dv) { return v < nb ? 0 : std::abs(val[v] + dv - 6); };
-    int flips = 0;
-    for (std::size_t t = 0; t < t_.tris.size(); ++t) {
-      if (!alive(t)) continue;
-      for (int i = 0; i < 3; ++i) {
-        const int u = t_.adj[t][i];
-        if (u < 0 || t_.is_constrained(static_cast<int>(t), i)) continue;
-        const auto tv = t_.tris[t];
-        const int a = tv[i], b = tv[Triangulation2d::next(i)], c = tv[Triangulation2d::prev(i)];
-        const int d = t_.tris[u][t_.mirror(static_cast<int>(t), i)];
-        const int before_dev = dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0);
-        const int after_dev = dev(a, 1) + dev(b, -1) + dev(c, -1) + dev(d, 1);
-        if (after_dev >= before_dev) continue;
-        const double before = std::min(quality(a, b, c), quality(d, c, b));
-        const double after = std::min(quality(a, b, d), quality(d, c, a));
-        if (after > 0 && after >= std::min(before, kValenceFloor)) {
-          t_.flip(static_cast<int>(t), i);
-          ++val[a]; ++val[d]; --val[b]; --val[c];
-          ++flips;
-          break;
-        }
-      }
-    }
-    out_.flips += flips;
-    return flips;
+    return flip_where([&](int a, int b, int c, int d) {
+      if (dev(a, 1) + dev(b, -1) + dev(c, -1) + dev(d, 1) >= dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0))
+        return false;
+      const double before = std::min(quality(a, b, c), quality(d, c, b));
+      const double after = std::min(quality(a, b, d), quality(d, c, a));
+      if (!(after > 0 && after >= std::min(before, kValenceFloor))) return false;
+      ++val[a];
+      ++val[d];
+      --val[b];
+      --val[c];
+      return true;
+    });
   }
 
+  // Moves each interior vertex towards the mean of the apexes of the
+  // equilateral triangles standing on the edges of its ball, built in 3D in
+  // the tangent plane at the vertex and taken back to the plane through the
+  // tangent map (least squares), which evens out shapes and edge lengths
+  // whatever the parametrization does. A move is kept when no triangle of
+  // the ball folds, its worst one does not get worse and the sum of
+  // qualities grows; balls with a poor triangle (or where that fails) take
+  // whichever of that point, the plain centroid of the neighbours and the
+  // halfway points raises their worst triangle most.
   int smooth_pass() {
     const std::size_t nv = uv_.size();
     // Balls as flat arrays: ball_start[v] .. ball_start[v + 1] in ball.

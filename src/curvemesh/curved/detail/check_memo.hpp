@@ -6,8 +6,6 @@
 // candidates again on the next pass. Results are remembered keyed by the
 // nodes themselves, compared exactly, so a temporary node override, a
 // scratch vertex reusing an id or a moved vertex can never hit a stale one.
-#include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "curvemesh/curved/element_check.hpp"
@@ -16,19 +14,18 @@ namespace cm::curved::detail {
 
 class CheckMemo {
  public:
-  CheckMemo(int order, const Acceptance& acceptance) : order_(order), acceptance_(acceptance) {}
+  CheckMemo(int order, const Acceptance& acceptance) : table_(order), acceptance_(acceptance) {}
 
-  ElementCheck operator()(std::vector<Vec3>&& nodes) {
-    const std::uint64_t key = hash_nodes(nodes);
-    if (const auto it = memo_.find(key); it != memo_.end() && it->second.nodes == nodes) {
+  ElementCheck operator()(const std::vector<Vec3>& nodes) {
+    if (const ElementCheck* known = table_.find(nodes)) {
       ++hits_;
-      return it->second.result;
+      return *known;
     }
     ++misses_;
-    const ElementCheck c = check_element(order_, nodes, acceptance_);
+    const ElementCheck c = check_element(table_.order(), nodes, acceptance_);
     // A bounded memory: start afresh rather than track ages.
-    if (memo_.size() >= kMaxEntries) memo_.clear();
-    memo_[key] = {std::move(nodes), c};
+    if (table_.size() >= kMaxEntries) table_.clear();
+    table_.add(nodes, c);
     return c;
   }
   std::size_t hits() const { return hits_; }
@@ -36,13 +33,8 @@ class CheckMemo {
 
  private:
   static constexpr std::size_t kMaxEntries = 1 << 18;
-  struct Entry {
-    std::vector<Vec3> nodes;
-    ElementCheck result;
-  };
-  int order_;
+  CheckCache table_;
   Acceptance acceptance_;
-  std::unordered_map<std::uint64_t, Entry> memo_;
   std::size_t hits_ = 0, misses_ = 0;
 };
 

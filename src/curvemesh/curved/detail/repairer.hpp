@@ -144,7 +144,14 @@ class ScratchVertex {
 class Repairer {
  public:
   Repairer(mesh::TetMesh& m, const geom::Model& model, const RepairOptions& o)
-      : m_(m), model_(model), o_(o), ed_(m), boundary_(m), placer_(m, model), order_(m.high_order.order()), memo_(order_, o.acceptance) {
+      : m_(m),
+        model_(model),
+        o_(o),
+        ed_(m),
+        boundary_(m),
+        placer_(m, model),
+        order_(m.high_order.order()),
+        memo_(order_, o.acceptance) {
     modify::mark_boundary_faces(ed_);
     ed_.set_hook([this](const mesh::TetMesh&, std::span<const TetId> created) { after_edit(created); });
   }
