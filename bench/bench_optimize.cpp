@@ -22,6 +22,7 @@
 //
 //   bench_optimize MODEL H [MODEL H ...]     e.g. t20_data.step 1.2 Zylkopf.stp 0.65
 //   bench_optimize MESH.msh [...]            an existing mesh (no Gmsh row)
+//   bench_optimize --adapt-only              only the analytic adaptation cases
 // Models are looked up in the shared models folder when not found as given.
 // Prints a table, then one JSON record per row.
 #include <unistd.h>
@@ -40,6 +41,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "curvemesh/core/predicates.hpp"
@@ -271,6 +273,10 @@ void run_adaptation(const AdaptCase& c, int cells) {
   const auto before = cm::optimize::summarize_mesh(m, &field);
   cm::optimize::AdaptOptions o;
   o.sizes = c.field.get();
+  // As `curvemesh optimize --move-flat-boundary` runs it: the box's faces
+  // are flat, and an anisotropic metric is worked on up to 0.9.
+  o.flat_boundary = true;
+  if (c.field->anisotropic()) o.threshold = 0.9;
   const double c0 = cpu_now();
   const cm::Timer wall;
   const auto st = cm::optimize::adapt_to_metric(m, field, o);
@@ -283,6 +289,9 @@ void run_adaptation(const AdaptCase& c, int cells) {
              st.lengths_after.percent_in_range(), after.min_metric_quality, after.mean_metric_quality,
              after.min_dihedral, st.split_seconds, st.collapse_seconds, st.swap_seconds, st.relocation_seconds,
              valid ? "" : "  INVALID");
+  const auto& l = st.lengths_after;
+  fmt::print("{:<34} lengths min {:.3f} mean {:.3f} max {:.3f}, short {} long {} of {}; per 0.25: {}\n", "", l.min,
+             l.mean, l.max, l.too_short, l.too_long, l.edges, fmt::join(l.histogram, " "));
   fmt::print("{}\n", nlohmann::json{{"case", c.name},
                                     {"optimizer", "curvemesh adapt"},
                                     {"valid", valid},
@@ -292,6 +301,9 @@ void run_adaptation(const AdaptCase& c, int cells) {
                                     {"tets_after", after.tets},
                                     {"percent_in_range_before", st.lengths_before.percent_in_range()},
                                     {"percent_in_range_after", st.lengths_after.percent_in_range()},
+                                    {"too_short_after", st.lengths_after.too_short},
+                                    {"too_long_after", st.lengths_after.too_long},
+                                    {"threshold", o.threshold},
                                     {"metric_quality_min", after.min_metric_quality},
                                     {"metric_quality_mean", after.mean_metric_quality},
                                     {"min_dihedral", after.min_dihedral},
@@ -308,7 +320,12 @@ void run_adaptation(const AdaptCase& c, int cells) {
 
 int main(int argc, char** argv) {
   std::vector<Case> cases;
+  bool adapt_only = false;
   for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--adapt-only") {
+      adapt_only = true;
+      continue;
+    }
     fs::path f = argv[i];
     if (!fs::exists(f)) f = cm::bench::models_dir() / argv[i];
     Case c{f, 0, {}};
@@ -321,7 +338,7 @@ int main(int argc, char** argv) {
     }
     cases.push_back(c);
   }
-  if (cases.empty()) {
+  if (cases.empty() && !adapt_only) {
     cases = {{cm::bench::models_dir() / "t20_data.step", 1.2, {}}, {cm::bench::models_dir() / "Zylkopf.stp", 0.65, {}}};
   }
   // How many of the worst tets left under 10 degrees to list per row.
@@ -453,7 +470,8 @@ int main(int argc, char** argv) {
   fs::remove_all(tmp);
   if (!std::getenv("CM_BENCH_NO_ADAPT")) {
     using cm::size::make_expression_field;
-    fmt::print("\nadaptation of a 10^3 Kuhn box to analytic fields (new vertices take the field's value):\n");
+    fmt::print("\nadaptation of a 10^3 Kuhn box to analytic fields (new vertices take the field's value; boundary "
+               "vertices move and go within the box's flat faces):\n");
     run_adaptation({"shock h=0.02+0.2|x-0.5|", make_expression_field("0.02 + 0.2*abs(x - 0.5)")}, 10);
     run_adaptation({"aniso hx=0.01+0.2|x-0.5|, 0.1, 0.1",
                     std::make_shared<AxisSizes>(std::array<std::shared_ptr<const cm::size::SizeField>, 3>{

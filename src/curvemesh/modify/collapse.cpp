@@ -36,23 +36,6 @@ struct Scratch {
   std::vector<Index> tris_a, tris_b;
 };
 
-// Classified triangles through v, found among the faces of its ball.
-void tris_around(const mesh::TetMesh& m, const BoundaryIndex& surf, VertId v, const std::vector<TetId>& ball,
-                 std::vector<Index>& out) {
-  out.clear();
-  for (TetId t : ball) {
-    const auto& tv = m.tet2verts[t];
-    const int iv = mesh::local_index(m, t, v);
-    for (int f = 0; f < 4; ++f) {
-      if (f == iv) continue;
-      const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
-      const Index i = surf.find_tri(tv[fv[0]], tv[fv[1]], tv[fv[2]]);
-      if (i != kNone) out.push_back(i);
-    }
-  }
-  sort_unique(out);
-}
-
 // Surface neighbours of v: the other vertices of its triangles.
 void surface_neighbours(const mesh::TetMesh& m, VertId v, const std::vector<Index>& tris, std::vector<VertId>& out) {
   out.clear();
@@ -66,6 +49,20 @@ std::array<VertId, 3> moved(std::array<VertId, 3> t, VertId from, VertId to) {
   for (VertId& v : t)
     if (v == from) v = to;
   return t;
+}
+
+// Whether removing a into b leaves the surface as it is (see
+// CollapsePlan::keeps_surface). `tris` are the classified triangles through
+// a.
+bool keeps_surface(const mesh::TetMesh& m, const BoundaryIndex& surf, VertId a, VertId b,
+                   const std::vector<Index>& tris, const std::vector<VertId>& near_a) {
+  if (!flat_per_face(m, tris)) return false;
+  if (m.vert_class[a].dim != 1) return true;
+  for (VertId x : near_a)
+    if (x != b)
+      if (const Index e = surf.find_edge(a, x); e != kNone && !collinear(m.coords[x], m.coords[a], m.coords[b]))
+        return false;
+  return true;
 }
 
 bool classification_allows(const mesh::TetMesh& m, const BoundaryIndex& surf, VertId a, VertId b,
@@ -182,9 +179,9 @@ CollapsePlan plan_collapse(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
   }
   // On the surface: neighbours shared by a and b must be apexes of the
   // triangles through (a, b); nothing may come out twice.
-  tris_around(m, surf, a, s.ball_a, s.tris_a);
+  tris_through(m, surf, a, s.ball_a, s.tris_a);
   if (!s.tris_a.empty()) {
-    tris_around(m, surf, b, s.ball_b, s.tris_b);
+    tris_through(m, surf, b, s.ball_b, s.tris_b);
     surface_neighbours(m, a, s.tris_a, s.surf_a);
     surface_neighbours(m, b, s.tris_b, s.surf_b);
     s.apexes.clear();
@@ -250,6 +247,7 @@ CollapsePlan plan_collapse(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
       }
     }
   }
+  plan.keeps_surface = s.tris_a.empty() || keeps_surface(m, surf, a, b, s.tris_a, s.near_a);
   return plan;
 }
 
@@ -282,7 +280,7 @@ std::span<const TetId> apply(MeshEditor& ed, Cavity& cav, BoundaryIndex& surf, c
 
   // The boundary entities through a, found before the ball goes.
   ball.assign(cav.tets().begin(), cav.tets().end());
-  tris_around(m, surf, a, ball, tris);
+  tris_through(m, surf, a, ball, tris);
   edges.clear();
   for (TetId t : ball)
     for (VertId x : m.tet2verts[t])

@@ -21,7 +21,9 @@
 //   with it before (kFoldedSurface).
 // b does not move, so the model is optional: without it boundary vertices
 // still collapse along their own entity when the rules allow (the surface is
-// then checked combinatorially and by normals only).
+// then checked combinatorially and by normals only). The plan also tells
+// whether the surface stays the same point set (keeps_surface), which is
+// what a driver without a model needs to let a boundary vertex go.
 //
 // Applying keeps adjacency, vert2tet, orientation, region tags, m.tris
 // (triangles through (a, b) removed, the others through a moved to b with
@@ -42,6 +44,12 @@ struct CollapsePlan {
   double before = 0, after = 0;
   /// from is on the hull (the collapse changes hull faces).
   bool on_hull = false;
+  /// The boundary surface is the same point set after the collapse: every
+  /// classified triangle through from lies, exactly (orient3d), in one
+  /// plane with the others of its model face, and a from on a model edge
+  /// lies exactly on the straight line through its neighbours along it. A
+  /// region vertex keeps it trivially. Only meaningful without a refusal.
+  bool keeps_surface = true;
 };
 
 /// Plans collapsing `from` into `to`. Precondition: both are vertices of the

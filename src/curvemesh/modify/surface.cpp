@@ -294,6 +294,84 @@ bool agrees_with_model(const geom::Model& model, int face, const Vec3& a, const 
   return tri_normal(a, b, c).dot(model.face_normal(face, p.param)) > 0;
 }
 
+void tris_through(const mesh::TetMesh& m, const BoundaryIndex& boundary, VertId v, std::span<const TetId> ball,
+                  std::vector<Index>& out) {
+  out.clear();
+  for (TetId t : ball) {
+    const auto& tv = m.tet2verts[t];
+    const int iv = mesh::local_index(m, t, v);
+    for (int f = 0; f < 4; ++f) {
+      if (f == iv) continue;
+      const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
+      const Index i = boundary.find_tri(tv[fv[0]], tv[fv[1]], tv[fv[2]]);
+      if (i != kNone) out.push_back(i);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+bool flat_per_face(const mesh::TetMesh& m, std::span<const Index> tris) {
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    const auto& tri = m.tris[tris[i]];
+    std::size_t r = 0;
+    while (m.tris[tris[r]].face_tag != tri.face_tag) ++r;
+    if (r == i) continue;
+    const auto& ref = m.tris[tris[r]].verts;
+    for (VertId x : tri.verts)
+      if (predicates::orient3d(m.coords[ref[0]].data(), m.coords[ref[1]].data(), m.coords[ref[2]].data(),
+                               m.coords[x].data()) != 0)
+        return false;
+  }
+  return true;
+}
+
+bool collinear(const Vec3& p, const Vec3& q, const Vec3& r) {
+  for (int k = 0; k < 3; ++k) {
+    const int i = k, j = (k + 1) % 3;
+    const double a[2] = {p[i], p[j]}, b[2] = {q[i], q[j]}, c[2] = {r[i], r[j]};
+    if (predicates::orient2d(a, b, c) != 0) return false;
+  }
+  return true;
+}
+
+std::optional<Vec3> slide_on_flat_boundary(const mesh::TetMesh& m, const BoundaryIndex& boundary, VertId v,
+                                           std::span<const Index> tris, std::span<const TetId> ball,
+                                           const Vec3& p) {
+  const int dim = m.vert_class[v].dim;
+  if ((dim != 1 && dim != 2) || tris.empty() || !flat_per_face(m, tris)) return std::nullopt;
+  // Coordinates every point of the plane or line shares are copied, so
+  // that rounding cannot take the point off it.
+  auto snap = [](Vec3 x, std::span<const Vec3> on) {
+    for (int k = 0; k < 3; ++k)
+      if (std::all_of(on.begin(), on.end(), [&](const Vec3& y) { return y[k] == on[0][k]; })) x[k] = on[0][k];
+    return x;
+  };
+  if (dim == 2) {
+    const auto& ref = m.tris[tris[0]].verts;
+    const Vec3 &a = m.coords[ref[0]], &b = m.coords[ref[1]], &c = m.coords[ref[2]];
+    const Vec3 n = (b - a).cross(c - a);
+    if (!(n.squaredNorm() > 0)) return std::nullopt;
+    const std::array<Vec3, 4> on{a, b, c, m.coords[v]};
+    const Vec3 x = snap(p - n * ((p - a).dot(n) / n.squaredNorm()), on);
+    if (predicates::orient3d(a.data(), b.data(), c.data(), x.data()) != 0) return std::nullopt;
+    return x;
+  }
+  std::array<VertId, 2> ends{kNone, kNone};
+  int found = 0;
+  for (TetId t : ball)
+    for (VertId w : m.tet2verts[t])
+      if (w != v && w != ends[0] && found < 2 && boundary.find_edge(v, w) != kNone) ends[found++] = w;
+  if (found != 2) return std::nullopt;
+  const Vec3 &a = m.coords[ends[0]], &b = m.coords[ends[1]];
+  if (!collinear(a, m.coords[v], b)) return std::nullopt;
+  const Vec3 d = b - a;
+  const std::array<Vec3, 3> on{a, b, m.coords[v]};
+  const Vec3 x = snap(a + d * ((p - a).dot(d) / d.squaredNorm()), on);
+  if (!collinear(a, x, b)) return std::nullopt;
+  return x;
+}
+
 double tet_quality_at(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return -1;
   return std::max(quality::tet_mean_ratio(a, b, c, d), 0.0);

@@ -101,6 +101,33 @@ std::optional<Vec2> param_on_face(const mesh::TetMesh& m, const geom::Model* mod
 std::optional<Vec2> check_hint(const mesh::TetMesh& m, const std::array<VertId, 3>& verts, int face,
                                VertId moved = kNone, std::optional<Vec2> moved_param = {});
 
+/// Classified triangles through v (indices into m.tris, sorted, each once),
+/// found among the faces of its ball.
+void tris_through(const mesh::TetMesh& m, const BoundaryIndex& boundary, VertId v, std::span<const TetId> ball,
+                  std::vector<Index>& out);
+
+/// Whether the classified triangles `tris` lie exactly (orient3d) in one
+/// plane per model face: each in the plane of the first of its face in the
+/// list.
+bool flat_per_face(const mesh::TetMesh& m, std::span<const Index> tris);
+
+/// Whether p, q and r lie exactly on one line (orient2d in the three
+/// coordinate planes).
+bool collinear(const Vec3& p, const Vec3& q, const Vec3& r);
+
+/// Where a boundary vertex may go without a model and leave the surface the
+/// same point set: the point nearest `p` on the plane of its triangles (a
+/// vertex on a model face) or on the line through its two neighbours along
+/// its model edge (both ends found in m.edges), when that plane or line is
+/// exactly flat around it (flat_per_face, collinear) and the point lies on
+/// it exactly once rounded. That holds for planes and lines parallel to the
+/// coordinate axes, whose fixed coordinates are copied exactly, and seldom
+/// otherwise; nothing when it does not (or v is not on a model edge or
+/// face). `tris` are v's triangles (tris_through), `ball` its tets.
+std::optional<Vec3> slide_on_flat_boundary(const mesh::TetMesh& m, const BoundaryIndex& boundary, VertId v,
+                                           std::span<const Index> tris, std::span<const TetId> ball,
+                                           const Vec3& p);
+
 /// Face f of a tet with vertices tv, in the order of mesh::kFaceVerts
 /// (its normal out of the tet).
 inline std::array<VertId, 3> tet_face(const std::array<VertId, 4>& tv, int f) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
@@ -69,6 +70,37 @@ bool reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f
   return true;
 }
 
+// The worst metric quality of a vertex's ball as the vertex moves. The
+// tets' metrics are the means of their vertices' and do not depend on where
+// the vertex is, so each is computed once (one eigen-solve) and a candidate
+// position costs a mean ratio per tet.
+class BallQuality {
+ public:
+  void reset(const mesh::TetMesh& m, const MetricField& f, std::span<const TetId> ball) {
+    field_ = &f;
+    tets_.assign(ball.begin(), ball.end());
+    metrics_.clear();
+    if (f.anisotropic())
+      for (TetId t : tets_) metrics_.push_back(f.tet_metric(m.tet2verts[t]));
+  }
+  double min(const mesh::TetMesh& m) const {
+    if (!field_->anisotropic()) return min_metric_quality(m, *field_, tets_);
+    double q = 1;
+    for (std::size_t i = 0; i < tets_.size(); ++i) {
+      const auto& v = m.tet2verts[tets_[i]];
+      const Vec3 &a = m.coords[v[0]], &b = m.coords[v[1]], &c = m.coords[v[2]], &d = m.coords[v[3]];
+      if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return -1;
+      q = std::min(q, std::max(quality::tet_metric_mean_ratio(a, b, c, d, metrics_[i]), 0.0));
+    }
+    return q;
+  }
+
+ private:
+  const MetricField* field_ = nullptr;
+  std::vector<TetId> tets_;
+  std::vector<size::Metric> metrics_;
+};
+
 // Moves v where its ball is best in the metric: candidates are the centroid
 // of its neighbours and the point at unit metric distance from each of them
 // (their average), each tried whole and damped.
@@ -94,11 +126,23 @@ bool relocate_on_model(modify::MeshEditor& ed, modify::Cavity& cav, const modify
   return true;
 }
 
-bool relocate(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f, VertId v,
-              std::vector<TetId>& ball, std::vector<VertId>& ring) {
+// Region vertices move freely; with flat_boundary (no model), boundary
+// vertices move within an exactly flat face or straight model edge
+// (modify::slide_on_flat_boundary), so the surface stays as it was. Their
+// parameters are then unknown (NaN).
+bool relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::BoundaryIndex& boundary,
+              bool flat_boundary, const MetricField& f, VertId v, std::vector<TetId>& ball,
+              std::vector<VertId>& ring) {
   auto& m = ed.mesh();
-  if (v >= m.vert_class.size() || m.vert_class[v].dim != 3 || m.vert2tet[v] == kNone) return false;
+  if (v >= m.vert_class.size() || m.vert2tet[v] == kNone) return false;
+  const int dim = m.vert_class[v].dim;
+  if (dim != 3 && (!flat_boundary || dim < 1)) return false;
   mesh::collect_ball(m, v, ball);
+  thread_local std::vector<Index> tris;
+  if (dim != 3) {
+    modify::tris_through(m, boundary, v, ball, tris);
+    if (!modify::slide_on_flat_boundary(m, boundary, v, tris, ball, m.coords[v])) return false;
+  }
   cav.reset(ed);
   ring.clear();
   for (TetId t : ball) {
@@ -117,22 +161,28 @@ bool relocate(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f,
   }
   centroid /= static_cast<double>(ring.size());
   unit /= static_cast<double>(ring.size());
-  const double before = min_metric_quality(m, f, ball);
+  thread_local BallQuality quality;
+  quality.reset(m, f, ball);
+  const double before = quality.min(m);
   modify::Relocation r;
   r.before = r.after = before;
   r.target = old;
   for (const Vec3& goal : {centroid, unit})
     for (double w : {1.0, 0.5, 0.25}) {
-      m.coords[v] = old + w * (goal - old);
-      const double q = min_metric_quality(m, f, ball);
+      std::optional<Vec3> x = old + w * (goal - old);
+      if (dim != 3) x = modify::slide_on_flat_boundary(m, boundary, v, tris, ball, *x);
+      if (!x) continue;
+      m.coords[v] = *x;
+      const double q = quality.min(m);
       if (q > r.after) {
         r.after = q;
-        r.target = m.coords[v];
+        r.target = *x;
       }
+      m.coords[v] = old;
     }
-  m.coords[v] = old;
   if (!(r.after > r.before + kMargin)) return false;
   modify::apply(ed, cav, v, r);
+  if (dim != 3) m.vert_param[v] = mesh::Param{};
   return true;
 }
 
@@ -268,11 +318,13 @@ std::size_t collapse_short_edges(modify::MeshEditor& ed, modify::Cavity& cav, mo
   for (const EdgeTask& e : tasks) {
     if (find_edge_tet(ed, e.a, e.b, e.tet, ball) == kNone) continue;
     for (const auto& [from, to] : {std::pair{e.a, e.b}, std::pair{e.b, e.a}}) {
-      // Without a model a boundary vertex stays: removing it would change
-      // the surface wherever it is not flat.
-      if (!o.model && m.vert_class[from].dim != 3) continue;
       const modify::CollapsePlan plan = modify::plan_collapse(ed, cav, boundary, from, to, o.model);
       if (plan.refusal != modify::Refusal::kNone) continue;
+      // Without a model a boundary vertex goes only when allowed, and
+      // where the surface is exactly flat around it (straight along a
+      // model edge), so the surface and the volume stay what they were,
+      // as boundary splits at midpoints leave them.
+      if (!o.model && m.vert_class[from].dim != 3 && !(o.flat_boundary && plan.keeps_surface)) continue;
       // The tets that survive, with from replaced by to; and the edges
       // from to to the rest of the ball, which must not come out long.
       double q = 1;
@@ -361,6 +413,26 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
   std::vector<std::pair<double, TetId>> bad;
   std::vector<TetId> ball;
   std::vector<VertId> ring;
+  std::vector<int> tried;  // the last pass that tried to relocate each vertex
+  // A tet that nothing improved is worked on again only after an edit
+  // touched one of its vertices: until then every operator would refuse it
+  // for the same reasons (swaps see the same shells, relocations the same
+  // balls). Each edit ticks the clock and stamps the vertices of the tets
+  // it created; a tet remembers when it was last given up on.
+  std::uint64_t clock = 1;
+  std::vector<std::uint64_t> vert_clock(m.num_verts(), clock), given_up;
+  ed.set_hook([&](const mesh::TetMesh& mm, std::span<const TetId> created) {
+    ++clock;
+    if (vert_clock.size() < mm.num_verts()) vert_clock.resize(mm.num_verts(), clock);
+    for (TetId t : created)
+      for (VertId v : mm.tet2verts[t]) vert_clock[v] = clock;
+  });
+  auto unchanged_since_given_up = [&](TetId t) {
+    if (t >= given_up.size()) return false;
+    for (VertId v : m.tet2verts[t])
+      if (v >= vert_clock.size() || vert_clock[v] > given_up[t]) return false;
+    return true;
+  };
   // Lengths settle in a few passes (each split halves an edge); shapes may
   // need more, so passes go on while anything changes, up to twice the
   // budget of size passes.
@@ -390,7 +462,8 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
     }
     std::sort(bad.begin(), bad.end());
     for (const auto& [q0, t] : bad) {
-      if (ed.is_dead(t) || field.tet_quality(m, m.tet2verts[t]) >= o.threshold) continue;
+      if (ed.is_dead(t) || unchanged_since_given_up(t) || field.tet_quality(m, m.tet2verts[t]) >= o.threshold)
+        continue;
       if (o.deletion && delete_in_metric(ed, cav, boundary, o, field, t)) {
         ++st.deletions;
         ++changes;
@@ -410,7 +483,12 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
         const auto tv = m.tet2verts[t];
         bool moved = false;
         for (VertId v : tv) {
-          if (!relocate(ed, cav, field, v, ball, ring) &&
+          // Each vertex once a pass, as a smoothing sweep: a vertex in many
+          // poor tets would otherwise be searched again for each of them.
+          if (tried.size() < m.num_verts()) tried.resize(m.num_verts(), -1);
+          if (tried[v] == st.passes) continue;
+          tried[v] = st.passes;
+          if (!relocate(ed, cav, boundary, o.flat_boundary && !o.model, field, v, ball, ring) &&
               !relocate_on_model(ed, cav, boundary, o.model, field, v, ball))
             continue;
           refresh(field, o, m, v);
@@ -447,10 +525,14 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
           ++changes;
         }
         st.insertion_seconds += op.seconds();
+        if (best >= 0) continue;
       }
+      if (given_up.size() < m.tet2verts.size()) given_up.resize(m.tet2verts.size(), 0);
+      given_up[t] = clock;
     }
     if (changes == 0) break;
   }
+  ed.set_hook(nullptr);
   ed.compact();
   drop_unused_vertices(m, field);
   const Census after = census(ed, field, o.threshold);

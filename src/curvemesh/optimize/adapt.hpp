@@ -23,9 +23,14 @@
 // quality of what it replaces. A new vertex
 // gets the log-Euclidean interpolation of its edge's end metrics.
 //
-// The boundary. Without a model, boundary vertices never move nor go: a
-// boundary edge is split at its midpoint, which leaves the piecewise linear
-// surface (and the volume) as it was, and only region vertices collapse.
+// The boundary. Without a model, the surface (and the volume) stays the
+// same point set: a boundary edge is split at its midpoint, and by default
+// boundary vertices neither move nor go. With options.flat_boundary they
+// may, where the surface is exactly flat around them and, on a model edge,
+// exactly straight: collapses that keep the surface
+// (modify::CollapsePlan::keeps_surface) and moves within the plane or line
+// (modify::slide_on_flat_boundary), as on the faces of a box. Without that,
+// a boundary vertex next to a fine region keeps its short edges.
 // With a model (options.model, its tags those of the mesh's
 // classification), points split on boundary edges go onto the model and
 // boundary vertices collapse along their model entity (modify/split.hpp,
@@ -45,7 +50,10 @@ namespace cm::optimize {
 
 struct AdaptOptions {
   int passes = 8;
-  /// Tets whose quality in the metric is below this are worked on.
+  /// Tets whose quality in the metric is below this are worked on. In an
+  /// anisotropic metric, lengths come to [0.7, 1.4] only as the shapes do
+  /// (a tet with edges that far apart has a quality near 0.9 at best), so an
+  /// adaptation to one wants about 0.9; `curvemesh optimize` uses that.
   double threshold = 0.3;
   bool swaps = true;
   bool relocation = true;
@@ -58,6 +66,9 @@ struct AdaptOptions {
   /// Element deletion of poor tets on the boundary (with a model only), and
   /// the chord rule it keeps (modify::DeletionOptions).
   bool deletion = true;
+  /// Without a model, lets boundary vertices collapse and move where the
+  /// surface is exactly flat (straight along a model edge); see above.
+  bool flat_boundary = false;
   double chord_alpha = 0.04;
   /// The CAD model the mesh is classified on, or nullptr (boundary kept).
   const geom::Model* model = nullptr;
