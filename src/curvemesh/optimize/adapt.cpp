@@ -5,6 +5,7 @@
 #include <optional>
 #include <stdexcept>
 #include <tuple>
+#include <unordered_map>
 #include <vector>
 
 #include <fmt/format.h>
@@ -42,9 +43,67 @@ double metric_measure(const mesh::TetMesh& m, const std::array<VertId, 4>& v, co
   return static_cast<const MetricField*>(field)->tet_quality(m, v);
 }
 
+// Each edit ticks a clock and stamps the vertices of the tets it created
+// (the editor's hook), so "has anything around here changed since" is a
+// comparison of stamps: any edit of a tet, a vertex moved in it included,
+// re-creates it and stamps all four of its vertices.
+struct EditClock {
+  std::uint64_t now = 1;
+  std::vector<std::uint64_t> vert;  // last edit that created a tet through each vertex
+  void tick(const mesh::TetMesh& m, std::span<const TetId> created) {
+    ++now;
+    if (vert.size() < m.num_verts()) vert.resize(m.num_verts(), now);
+    for (TetId t : created)
+      for (VertId v : m.tet2verts[t]) vert[v] = now;
+  }
+  template <class... V>
+  bool unchanged_since(std::uint64_t when, V... v) const {
+    return ((v < vert.size() && vert[v] <= when) && ...);
+  }
+};
+
+// Reconnections found not to help, remembered until an edit touches them:
+// an edge's shell is rebuilt (stamping both its ends) by any edit of one of
+// its tets, and a face's two tets likewise stamp its three vertices. A poor
+// tet's neighbours are poor too and share its edges and faces, so without
+// this each shell would be solved again for each of them, pass after pass.
+class ReconnectMemo {
+ public:
+  explicit ReconnectMemo(const EditClock& clock) : clock_(clock) {}
+  bool edge_refused(VertId a, VertId b) const {
+    const auto it = edges_.find(edge_key(a, b));
+    return it != edges_.end() && clock_.unchanged_since(it->second, a, b);
+  }
+  void refuse_edge(VertId a, VertId b) { edges_[edge_key(a, b)] = clock_.now; }
+  bool face_refused(std::array<VertId, 3> f) const {
+    std::sort(f.begin(), f.end());
+    const auto it = faces_.find(f);
+    return it != faces_.end() && clock_.unchanged_since(it->second, f[0], f[1], f[2]);
+  }
+  void refuse_face(std::array<VertId, 3> f) {
+    std::sort(f.begin(), f.end());
+    faces_[f] = clock_.now;
+  }
+
+ private:
+  static std::uint64_t edge_key(VertId a, VertId b) {
+    return a < b ? (std::uint64_t{a} << 32 | b) : (std::uint64_t{b} << 32 | a);
+  }
+  struct FaceHash {
+    std::size_t operator()(const std::array<VertId, 3>& f) const {
+      return std::hash<std::uint64_t>()((std::uint64_t{f[0]} << 32 | f[1]) * 0x9E3779B97F4A7C15ull ^ f[2]);
+    }
+  };
+  const EditClock& clock_;
+  std::unordered_map<std::uint64_t, std::uint64_t> edges_;
+  std::unordered_map<std::array<VertId, 3>, std::uint64_t, FaceHash> faces_;
+};
+
 // The best reconnection of t in the metric: edge removal whose ring
-// triangulation is chosen in the metric, or a 2-3 face swap.
-bool reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f, TetId t, AdaptStats& st) {
+// triangulation is chosen in the metric, or a 2-3 face swap. Candidates
+// the memo knows to fail are skipped; those that fail are remembered.
+bool reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f, TetId t, ReconnectMemo& memo,
+               AdaptStats& st) {
   const auto& m = ed.mesh();
   int kind = -1, local = 0;
   double best_gain = kMargin;
@@ -54,13 +113,28 @@ bool reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f
       best_gain = p.after - p.before;
       kind = k;
       local = l;
+      return true;
     }
+    return false;
   };
-  for (int e = 0; e < 6; ++e)
-    consider(plan_measured_edge_removal(ed, cav, tv[mesh::kTetEdges[e][0]], tv[mesh::kTetEdges[e][1]], t,
-                                        metric_measure, &f),
-             0, e);
-  for (int fi = 0; fi < 4; ++fi) consider(plan_measured_face_swap(ed, cav, t, fi, metric_measure, &f), 1, fi);
+  for (int e = 0; e < 6; ++e) {
+    const VertId a = tv[mesh::kTetEdges[e][0]], b = tv[mesh::kTetEdges[e][1]];
+    if (memo.edge_refused(a, b)) continue;
+    const auto p = plan_measured_edge_removal(ed, cav, a, b, t, metric_measure, &f);
+    if (p.refusal != modify::Refusal::kNone || !(p.after - p.before > kMargin))
+      memo.refuse_edge(a, b);
+    else
+      consider(p, 0, e);
+  }
+  for (int fi = 0; fi < 4; ++fi) {
+    const auto face = modify::tet_face(tv, fi);
+    if (memo.face_refused(face)) continue;
+    const auto p = plan_measured_face_swap(ed, cav, t, fi, metric_measure, &f);
+    if (p.refusal != modify::Refusal::kNone || !(p.after - p.before > kMargin))
+      memo.refuse_face(face);
+    else
+      consider(p, 1, fi);
+  }
   if (kind < 0) return false;
   const auto p = kind == 0 ? plan_measured_edge_removal(ed, cav, tv[mesh::kTetEdges[local][0]],
                                                         tv[mesh::kTetEdges[local][1]], t, metric_measure, &f)
@@ -417,21 +491,15 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
   // A tet that nothing improved is worked on again only after an edit
   // touched one of its vertices: until then every operator would refuse it
   // for the same reasons (swaps see the same shells, relocations the same
-  // balls). Each edit ticks the clock and stamps the vertices of the tets
-  // it created; a tet remembers when it was last given up on.
-  std::uint64_t clock = 1;
-  std::vector<std::uint64_t> vert_clock(m.num_verts(), clock), given_up;
-  ed.set_hook([&](const mesh::TetMesh& mm, std::span<const TetId> created) {
-    ++clock;
-    if (vert_clock.size() < mm.num_verts()) vert_clock.resize(mm.num_verts(), clock);
-    for (TetId t : created)
-      for (VertId v : mm.tet2verts[t]) vert_clock[v] = clock;
-  });
+  // balls). A tet remembers when it was last given up on.
+  EditClock clock;
+  clock.vert.assign(m.num_verts(), clock.now);
+  std::vector<std::uint64_t> given_up;
+  ed.set_hook([&](const mesh::TetMesh& mm, std::span<const TetId> created) { clock.tick(mm, created); });
+  ReconnectMemo memo(clock);
   auto unchanged_since_given_up = [&](TetId t) {
-    if (t >= given_up.size()) return false;
-    for (VertId v : m.tet2verts[t])
-      if (v >= vert_clock.size() || vert_clock[v] > given_up[t]) return false;
-    return true;
+    const auto& v = m.tet2verts[t];
+    return t < given_up.size() && clock.unchanged_since(given_up[t], v[0], v[1], v[2], v[3]);
   };
   // Lengths settle in a few passes (each split halves an edge); shapes may
   // need more, so passes go on while anything changes, up to twice the
@@ -471,7 +539,7 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
       }
       if (o.swaps) {
         Timer op;
-        const bool done = reconnect(ed, cav, field, t, st);
+        const bool done = reconnect(ed, cav, field, t, memo, st);
         st.swap_seconds += op.seconds();
         if (done) {
           ++changes;
@@ -528,7 +596,7 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
         if (best >= 0) continue;
       }
       if (given_up.size() < m.tet2verts.size()) given_up.resize(m.tet2verts.size(), 0);
-      given_up[t] = clock;
+      given_up[t] = clock.now;
     }
     if (changes == 0) break;
   }
