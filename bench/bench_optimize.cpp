@@ -209,10 +209,11 @@ void print_row(const Row& r, double reference_cpu) {
 void print_worst(const Row& r, std::size_t count) {
   for (std::size_t i = 0; i < std::min(count, r.limit.worst.size()); ++i) {
     const auto& w = r.limit.worst[i];
-    fmt::print("    {:6.2f} deg  q {:.4f}  {:<18} cap {:6.2f}  {} boundary verts, {} boundary faces, at ({:.4g}, {:.4g}, "
-               "{:.4g})\n",
-               w.dihedral, w.mean_ratio, cm::optimize::to_string(w.why), w.cap, w.boundary_verts, w.boundary_faces,
-               w.centroid.x(), w.centroid.y(), w.centroid.z());
+    fmt::print("    {:6.2f} deg  q {:.4f}  {:<18} cap {:6.2f}{}  {} boundary verts, {} boundary faces, at ({:.4g}, "
+               "{:.4g}, {:.4g})\n",
+               w.dihedral, w.mean_ratio, cm::optimize::to_string(w.why), w.cap,
+               w.price < 1 ? fmt::format("  q at {:g} deg {:.4f}", r.limit.target, w.price) : "", w.boundary_verts,
+               w.boundary_faces, w.centroid.x(), w.centroid.y(), w.centroid.z());
   }
 }
 
@@ -235,6 +236,8 @@ nlohmann::json to_json(const Row& r) {
                                 {"pinned_min_mean_ratio", l.pinned_min_mean_ratio},
                                 {"pinned_min_cap", l.pinned_min_cap},
                                 {"free_below", l.free_below},
+                                {"held_by_thin_face", l.held_by_thin_face},
+                                {"held_min_price", l.min_price},
                                 {"free_min_dihedral", l.free_min_dihedral},
                                 {"free_min_mean_ratio", l.free_min_mean_ratio}};
   return {{"case", r.name},       {"optimizer", r.who},     {"ok", r.ok},       {"valid", r.valid},

@@ -206,6 +206,7 @@ nlohmann::json limit_json(const optimize::BoundaryLimit& l) {
                      {"mean_ratio", w.mean_ratio},
                      {"why", optimize::to_string(w.why)},
                      {"cap_deg", w.cap},
+                     {"mean_ratio_at_target", w.price},
                      {"boundary_vertices", w.boundary_verts},
                      {"boundary_faces", w.boundary_faces},
                      {"centroid", {w.centroid.x(), w.centroid.y(), w.centroid.z()}}});
@@ -217,6 +218,8 @@ nlohmann::json limit_json(const optimize::BoundaryLimit& l) {
           {"pinned_min_mean_ratio", l.pinned_min_mean_ratio},
           {"pinned_min_cap_deg", l.pinned_min_cap},
           {"free_below_target", l.free_below},
+          {"held_by_thin_face", l.held_by_thin_face},
+          {"held_min_mean_ratio_at_target", l.min_price},
           {"free_min_dihedral_deg", l.free_min_dihedral},
           {"free_min_mean_ratio", l.free_min_mean_ratio},
           {"worst", worst}};
@@ -229,12 +232,18 @@ std::string render_limit(const optimize::BoundaryLimit& l) {
   if (l.pinned)
     s += fmt::format(": min dihedral {:.2f} deg, min mean ratio {:.4f}, the boundary allows {:.2f} deg at best",
                      l.pinned_min_dihedral, l.pinned_min_mean_ratio, l.pinned_min_cap);
-  s += fmt::format("; {} free; free tets min dihedral {:.2f} deg, min mean ratio {:.4f}\n", l.free_below,
-                   l.free_min_dihedral, l.free_min_mean_ratio);
-  for (const auto& w : l.worst)
-    s += fmt::format("    {:6.2f} deg  mean ratio {:.4f}  {:<18}  cap {:6.2f} deg  at ({:.6g}, {:.6g}, {:.6g})\n",
-                     w.dihedral, w.mean_ratio, optimize::to_string(w.why), w.cap, w.centroid.x(), w.centroid.y(),
-                     w.centroid.z());
+  s += fmt::format("; {} free", l.free_below);
+  if (l.held_by_thin_face)
+    s += fmt::format(" ({} on a thin boundary face, where a tet at {:g} deg has mean ratio {:.4f} at best)",
+                     l.held_by_thin_face, l.target, l.min_price);
+  s += fmt::format("; free tets min dihedral {:.2f} deg, min mean ratio {:.4f}\n", l.free_min_dihedral,
+                   l.free_min_mean_ratio);
+  for (const auto& w : l.worst) {
+    s += fmt::format("    {:6.2f} deg  mean ratio {:.4f}  {:<18}  cap {:6.2f} deg", w.dihedral, w.mean_ratio,
+                     optimize::to_string(w.why), w.cap);
+    if (w.price < 1) s += fmt::format("  at {:g} deg {:.4f}", l.target, w.price);
+    s += fmt::format("  at ({:.6g}, {:.6g}, {:.6g})\n", w.centroid.x(), w.centroid.y(), w.centroid.z());
+  }
   return s;
 }
 

@@ -269,3 +269,37 @@ TEST(AdaptDriver, FlatBoundaryLetsTheBoxFacesAdaptAndKeepsThem) {
   EXPECT_GT(flat_st.lengths_after.percent_in_range(), fixed_st.lengths_after.percent_in_range());
   EXPECT_GT(flat_st.lengths_after.percent_in_range(), 92.0);  // measured 94.8 (89.9 without)
 }
+
+TEST(BoundaryLimit, AThinFaceHasAPriceAtTheTarget) {
+  // On an equilateral face the regular tet is at the target (70.5 deg).
+  const Vec3 a(0, 0, 0), b(1, 0, 0), up(0.5, 0.3, 1);
+  EXPECT_GT(best_mean_ratio_at_angle(a, b, Vec3(0.5, std::sqrt(3.0) / 2, 0), up, 10), 0.99);
+  // On a thin face the angle costs mean ratio, more as the target rises;
+  // the apex side does not matter for a flat face.
+  const Vec3 thin(0.5, 0.05, 0);
+  const double at0 = best_mean_ratio_at_angle(a, b, thin, up, 0);
+  const double at5 = best_mean_ratio_at_angle(a, b, thin, up, 5);
+  const double at10 = best_mean_ratio_at_angle(a, b, thin, up, 10);
+  EXPECT_GT(at10, 0.0);
+  EXPECT_LT(at10, at5);
+  EXPECT_LE(at5, at0 + 1e-9);
+  EXPECT_LT(at10, 0.25);  // measured 0.214 on this face of quality 0.115
+  EXPECT_NEAR(best_mean_ratio_at_angle(a, b, thin, Vec3(0.5, 0.3, -1), 10), at10, 1e-9);
+  // Unreachable: no tet on a face has all angles above the regular tet's.
+  EXPECT_EQ(best_mean_ratio_at_angle(a, b, thin, up, 75), 0.0);
+
+  // In a report, only free tets with one boundary face get a price, and a
+  // tet held by a thin face is one whose own mean ratio is above it.
+  auto box = test::perturbed_box(5, 2, 0.45, 12);
+  const auto l = classify_boundary_limit(box, 10, 1000);
+  std::size_t held = 0;
+  for (const auto& w : l.worst) {
+    if (w.why != BoundaryLimit::Why::kFree || w.boundary_faces != 1) {
+      EXPECT_EQ(w.price, 1.0);
+      continue;
+    }
+    EXPECT_GT(w.price, 0.0);
+    held += w.price < w.mean_ratio;
+  }
+  EXPECT_EQ(held, l.held_by_thin_face);
+}

@@ -1,6 +1,7 @@
 #include "curvemesh/optimize/boundary_limit.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -38,7 +39,55 @@ const char* to_string(BoundaryLimit::Why why) {
   return "?";
 }
 
+double best_mean_ratio_at_angle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& side, double target) {
+  const Vec3 g = (a + b + c) / 3;
+  Vec3 n = (b - a).cross(c - a);
+  const double area2 = n.norm();
+  if (!(area2 > 0)) return 0;
+  n /= area2;
+  if (n.dot(side - g) < 0) n = -n;
+  const Vec3 e1 = (b - a).normalized(), e2 = n.cross(e1);
+  const double scale = std::sqrt(area2);  // about the triangle's size
+  // One number to climb: below the target the angle (in [0, 1)), at it
+  // 1 + the mean ratio, so an infeasible start climbs the angle first.
+  auto score = [&](const Vec3& x) {
+    const Vec3 d = g + scale * (x[0] * e1 + x[1] * e2 + x[2] * n);
+    const double angle = quality::tet_dihedral_range(a, b, c, d).min;
+    if (angle < target) return angle / target;
+    return 1 + std::max(quality::tet_mean_ratio(a, b, c, d), quality::tet_mean_ratio(a, c, b, d));
+  };
+  // Starts: above the centroid at about a regular tet's height, and above
+  // each corner and each edge's midpoint, low and high.
+  std::vector<Vec3> starts{Vec3(0, 0, 0.8)};
+  for (const Vec3& p : {a, b, c, Vec3((a + b) / 2), Vec3((b + c) / 2), Vec3((c + a) / 2)}) {
+    const Vec3 local((p - g).dot(e1) / scale, (p - g).dot(e2) / scale, 0);
+    for (double h : {0.3, 1.0}) starts.push_back(local + Vec3(0, 0, h));
+  }
+  double best = 0;
+  for (Vec3 x : starts) {
+    double cur = score(x);
+    for (double step = 0.25; step > 1e-3; step /= 2) {
+      for (bool moved = true; moved;) {
+        moved = false;
+        for (int k = 0; k < 6; ++k) {
+          Vec3 y = x;
+          y[k / 2] += k % 2 ? -step : step;
+          if (!(y[2] > 0)) continue;
+          if (const double s = score(y); s > cur + 1e-12) {
+            x = y;
+            cur = s;
+            moved = true;
+          }
+        }
+      }
+    }
+    if (cur >= 1) best = std::max(best, cur - 1);
+  }
+  return best;
+}
+
 BoundaryLimit classify_boundary_limit(const mesh::TetMesh& m, double target, std::size_t worst) {
+  constexpr std::size_t kPriced = BoundaryLimit::kPriced;
   BoundaryLimit r;
   r.target = target;
   // Every tet face once: a face seen once is on the hull.
@@ -96,6 +145,12 @@ BoundaryLimit classify_boundary_limit(const mesh::TetMesh& m, double target, std
         it->second += angles[static_cast<std::size_t>(e)];
       }
     }
+  // Worst first, so that the price search (which costs about a third of a
+  // millisecond a tet) is spent on the worst kPriced of them.
+  std::sort(bad.begin(), bad.end(), [](const auto& x, const auto& y) {
+    return x.dihedral != y.dihedral ? x.dihedral < y.dihedral : x.tet < y.tet;
+  });
+  std::size_t priced = 0;
   for (auto& b : bad) {
     const auto& tv = m.tet2verts[b.tet];
     Why why = Why::kFree;
@@ -117,6 +172,17 @@ BoundaryLimit classify_boundary_limit(const mesh::TetMesh& m, double target, std
       is_bad[b.tet] = 2;
     } else {
       ++r.free_below;
+      if (b.boundary_faces == 1 && priced++ < kPriced)
+        for (int f = 0; f < 4; ++f) {
+          const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
+          if (!boundary.count(sorted(tv[fv[0]], tv[fv[1]], tv[fv[2]]))) continue;
+          b.price = best_mean_ratio_at_angle(m.coords[tv[fv[0]]], m.coords[tv[fv[1]]], m.coords[tv[fv[2]]],
+                                             m.coords[tv[f]], target);
+          if (b.price < b.mean_ratio) {
+            ++r.held_by_thin_face;
+            r.min_price = std::min(r.min_price, b.price);
+          }
+        }
     }
   }
   for (TetId t = 0; t < m.num_tets(); ++t) {
@@ -126,9 +192,6 @@ BoundaryLimit classify_boundary_limit(const mesh::TetMesh& m, double target, std
     r.free_min_mean_ratio = std::min(r.free_min_mean_ratio, quality::tet_mean_ratio(p0, p1, p2, p3));
     r.free_min_dihedral = std::min(r.free_min_dihedral, quality::tet_dihedral_range(p0, p1, p2, p3).min);
   }
-  std::sort(bad.begin(), bad.end(), [](const auto& x, const auto& y) {
-    return x.dihedral != y.dihedral ? x.dihedral < y.dihedral : x.tet < y.tet;
-  });
   if (bad.size() > worst) bad.resize(worst);
   r.worst = std::move(bad);
   return r;

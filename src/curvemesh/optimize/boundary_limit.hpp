@@ -12,12 +12,21 @@
 // triangle is the face of a spindle-shaped tet with all dihedral angles
 // near 60° (a poor mean ratio, but a fair angle), so a tet with one boundary
 // face is free, whatever its vertices.
+// That fair angle has a price, though: on a thin triangle every tet with
+// all its angles at the target has a poor mean ratio. For a free tet with
+// one boundary face the report gives the best mean ratio found for a tet on
+// that face with its smallest angle at the target (a search over the apex):
+// where the tet's own mean ratio is above it, bringing it to the target
+// would lower the mesh's worst mean ratio, which the optimizer does not
+// trade below kRescueFloor (measured_swap.hpp). Those are "held by a thin
+// face".
 // A tet whose smallest dihedral angle is below the target and whose cap (the
 // least of these) is below the target too is "pinned by the boundary": no
 // operator that keeps the surface can bring it to the target. The rest are
 // "free": their angle is the optimizer's to answer for.
 // With a model the surface may change, so the same count on an optimized
 // mesh says what its final surface allows.
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -39,6 +48,12 @@ struct BoundaryLimit {
   /// Pinned tets by what pins them: two boundary faces, a boundary edge's
   /// wedge.
   std::size_t by_two_faces = 0, by_wedge = 0;
+  /// Free tets below the target held by a thin face (see above), and the
+  /// lowest price among them (1 when there are none). Only the kPriced
+  /// worst free tets with one boundary face are priced.
+  static constexpr std::size_t kPriced = 4096;
+  std::size_t held_by_thin_face = 0;
+  double min_price = 1;
 
   enum class Why { kFree, kTwoFaces, kWedge };
   /// A tet below the target: where it is, and what the boundary allows it.
@@ -49,14 +64,27 @@ struct BoundaryLimit {
     double cap = 180;  ///< the boundary's cap on its smallest angle (180: none)
     Why why = Why::kFree;
     int boundary_verts = 0, boundary_faces = 0;  ///< vertices not in a region; faces in m.tris or the hull
+    /// For a free tet with one boundary face: the best mean ratio found for
+    /// a tet on that face with all its angles at the target (1: not asked).
+    double price = 1;
   };
   /// The worst tets below the target, worst first (at most the count asked).
   std::vector<Tet> worst;
 };
 const char* to_string(BoundaryLimit::Why why);
 
+/// The best mean ratio found for a tet on triangle (a, b, c) whose smallest
+/// dihedral angle is at least `target_degrees`, its apex on the side of
+/// `side` (a point off the triangle's plane); 0 if none was found. A
+/// deterministic pattern search from several starts: a lower estimate of
+/// the true optimum, within a few percent on the shared models' faces.
+double best_mean_ratio_at_angle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& side,
+                                double target_degrees);
+
 /// Classifies the tets of a compact, conforming mesh (adjacency not needed).
-/// Boundary triangles are m.tris and the hull's faces. O(T) hashing.
+/// Boundary triangles are m.tris and the hull's faces. O(T) hashing, plus a
+/// search of a few hundred trial apexes per free tet below the target with
+/// one boundary face.
 BoundaryLimit classify_boundary_limit(const mesh::TetMesh& m, double target_degrees = 10, std::size_t worst = 8);
 
 }  // namespace cm::optimize
