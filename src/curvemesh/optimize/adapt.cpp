@@ -113,9 +113,7 @@ bool reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const MetricField& f
       best_gain = p.after - p.before;
       kind = k;
       local = l;
-      return true;
     }
-    return false;
   };
   for (int e = 0; e < 6; ++e) {
     const VertId a = tv[mesh::kTetEdges[e][0]], b = tv[mesh::kTetEdges[e][1]];
