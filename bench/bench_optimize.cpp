@@ -250,19 +250,24 @@ nlohmann::json to_json(const Row& r) {
 // coarse along it.
 class AxisSizes final : public cm::size::SizeField {
  public:
-  explicit AxisSizes(std::array<std::shared_ptr<const cm::size::SizeField>, 3> axes) : axes_(std::move(axes)) {}
+  /// Sizes along the columns of `frame` (orthonormal; the coordinate axes
+  /// by default).
+  explicit AxisSizes(std::array<std::shared_ptr<const cm::size::SizeField>, 3> axes,
+                     const cm::Mat3& frame = cm::Mat3::Identity())
+      : axes_(std::move(axes)), frame_(frame) {}
   double size(const cm::Vec3& x, const cm::size::SizeHint& = {}) const override {
     return std::min({axes_[0]->size(x), axes_[1]->size(x), axes_[2]->size(x)});
   }
   cm::size::Metric metric(const cm::Vec3& x, const cm::size::SizeHint& = {}) const override {
     cm::size::Metric m = cm::size::Metric::Zero();
     for (int k = 0; k < 3; ++k) m(k, k) = 1 / std::pow(axes_[static_cast<std::size_t>(k)]->size(x), 2);
-    return m;
+    return frame_ * m * frame_.transpose();
   }
   bool anisotropic() const override { return true; }
 
  private:
   std::array<std::shared_ptr<const cm::size::SizeField>, 3> axes_;
+  cm::Mat3 frame_;
 };
 
 struct AdaptCase {
@@ -480,6 +485,17 @@ int main(int argc, char** argv) {
                     std::make_shared<AxisSizes>(std::array<std::shared_ptr<const cm::size::SizeField>, 3>{
                         make_expression_field("0.01 + 0.2*abs(x - 0.5)"), make_expression_field("0.1"),
                         make_expression_field("0.1")})},
+                   10);
+    // The same across the diagonal plane x + y = 1: the metric's axes are
+    // not the mesh's, nor the box's.
+    cm::Mat3 diagonal;
+    diagonal << 0.70710678118654752, -0.70710678118654752, 0, 0.70710678118654752, 0.70710678118654752, 0, 0, 0, 1;
+    run_adaptation({"aniso rotated, fine across x+y=1",
+                    std::make_shared<AxisSizes>(
+                        std::array<std::shared_ptr<const cm::size::SizeField>, 3>{
+                            make_expression_field("0.01 + 0.2*abs(x + y - 1)*0.70710678118654752"),
+                            make_expression_field("0.1"), make_expression_field("0.1")},
+                        diagonal)},
                    10);
   }
   return 0;
