@@ -22,6 +22,7 @@
 #include "curvemesh/modify/relocate.hpp"
 #include "curvemesh/modify/split.hpp"
 #include "curvemesh/modify/swap.hpp"
+#include "curvemesh/optimize/detail/edit_clock.hpp"
 #include "curvemesh/optimize/measured_swap.hpp"
 #include "curvemesh/optimize/shell_insert.hpp"
 #include "curvemesh/quality/measures.hpp"
@@ -43,24 +44,7 @@ double metric_measure(const mesh::TetMesh& m, const std::array<VertId, 4>& v, co
   return static_cast<const MetricField*>(field)->tet_quality(m, v);
 }
 
-// Each edit ticks a clock and stamps the vertices of the tets it created
-// (the editor's hook), so "has anything around here changed since" is a
-// comparison of stamps: any edit of a tet, a vertex moved in it included,
-// re-creates it and stamps all four of its vertices.
-struct EditClock {
-  std::uint64_t now = 1;
-  std::vector<std::uint64_t> vert;  // last edit that created a tet through each vertex
-  void tick(const mesh::TetMesh& m, std::span<const TetId> created) {
-    ++now;
-    if (vert.size() < m.num_verts()) vert.resize(m.num_verts(), now);
-    for (TetId t : created)
-      for (VertId v : m.tet2verts[t]) vert[v] = now;
-  }
-  template <class... V>
-  bool unchanged_since(std::uint64_t when, V... v) const {
-    return ((v < vert.size() && vert[v] <= when) && ...);
-  }
-};
+using detail::EditClock;
 
 // Reconnections found not to help, remembered until an edit touches them:
 // an edge's shell is rebuilt (stamping both its ends) by any edit of one of
@@ -490,14 +474,12 @@ AdaptStats adapt_to_metric(mesh::TetMesh& m, MetricField& field, const AdaptOpti
   // touched one of its vertices: until then every operator would refuse it
   // for the same reasons (swaps see the same shells, relocations the same
   // balls). A tet remembers when it was last given up on.
-  EditClock clock;
-  clock.vert.assign(m.num_verts(), clock.now);
+  EditClock clock(m.num_verts());
   std::vector<std::uint64_t> given_up;
   ed.set_hook([&](const mesh::TetMesh& mm, std::span<const TetId> created) { clock.tick(mm, created); });
   ReconnectMemo memo(clock);
   auto unchanged_since_given_up = [&](TetId t) {
-    const auto& v = m.tet2verts[t];
-    return t < given_up.size() && clock.unchanged_since(given_up[t], v[0], v[1], v[2], v[3]);
+    return t < given_up.size() && clock.tet_unchanged_since(given_up[t], m.tet2verts[t]);
   };
   // Lengths settle in a few passes (each split halves an edge); shapes may
   // need more, so passes go on while anything changes, up to twice the
