@@ -258,7 +258,10 @@ std::string render_lengths(const optimize::LengthStats& l) {
   return s;
 }
 
-std::string boundary_policy(bool adapt, bool model) {
+std::string boundary_policy(bool adapt, bool model, bool flat) {
+  if (!model && adapt && flat)
+    return "kept as a surface (boundary edges split at their midpoints; boundary vertices moved and collapsed only "
+           "where it is exactly flat)";
   if (!model) return adapt ? "kept (boundary vertices fixed; boundary edges split at their midpoints)"
                            : "kept (boundary vertices and triangles unchanged)";
   return adapt ? "on the model (boundary vertices moved, split onto and collapsed along it; poor tets on it deleted)"
@@ -268,6 +271,9 @@ std::string boundary_policy(bool adapt, bool model) {
 
 int run_optimize(const OptimizeCliOptions& o) {
   Timer total, step;
+  if (o.flat_boundary && !has_size_spec(o))
+    throw InputError("--move-flat-boundary", -1, -1,
+                     "needs a size specification (--sol, --size-expr, --metric-expr, --hmin/--hmax or --aniso)");
   mesh::TetMesh m = io::read_mesh(o.input);
   if (m.high_order.order() > 1)
     throw InputError(o.input, -1, -1,
@@ -415,7 +421,7 @@ int run_optimize(const OptimizeCliOptions& o) {
     op_seconds = iso.seconds;
   }
   if (classified) j["classification"] = classification_json(*classified);
-  j["boundary"] = boundary_policy(metric != nullptr, model != nullptr);
+  j["boundary"] = boundary_policy(metric != nullptr, model != nullptr, o.flat_boundary);
   j["boundary_limit"] = limit_json(limit);
   j["seconds"] = {{"read", read_s},   {"classify", classify_s}, {"metric", metric_s}, {"optimize", optimize_s},
                   {"check", check_s}, {"write", write_s},       {"total", total.seconds()}};
@@ -452,7 +458,7 @@ int run_optimize(const OptimizeCliOptions& o) {
     }
     fmt::print("{}", render_limit(limit));
     fmt::print("volume: {:.10g} -> {:.10g}; boundary: {}\n", before.volume, after.volume,
-               boundary_policy(metric != nullptr, model != nullptr));
+               boundary_policy(metric != nullptr, model != nullptr, o.flat_boundary));
     fmt::print("check: {}", ok ? "valid" : "INVALID");
     if (!ok) fmt::print(" ({} inverted, {} flat, {} other issues)", check.num_inverted, check.num_flat,
                         check.num_issues - check.num_inverted - check.num_flat);

@@ -238,7 +238,13 @@ TEST(CliOptimize, MetricExpressionAdaptsToUnitLengths) {
   // Measured: 39% -> 94%, metric quality min 0.61; 58% with the boundary fixed.
   EXPECT_GT(f["lengths_after"]["percent_in_0_7_1_4"].get<double>(), 90.0);
   EXPECT_NEAR(f["after"]["volume"].get<double>(), f["before"]["volume"].get<double>(), 1e-12);
+  EXPECT_NE(f["boundary"].get<std::string>().find("exactly flat"), std::string::npos);
   EXPECT_EQ(run_cli("check " + dir + "/flat.msh -q").exit_code, 0);
+  // Shape optimization keeps boundary vertices fixed: the flag is an error there.
+  r = run_cli("optimize " + dir + "/box.msh --move-flat-boundary -o " + dir + "/iso.msh");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--move-flat-boundary"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/iso.msh"));
   r = run_cli("optimize " + dir + "/box.msh --metric-expr '0.1; 0.1' -o " + dir + "/bad.msh");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("three sizes"), std::string::npos) << r.output;
