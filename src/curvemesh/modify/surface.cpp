@@ -335,41 +335,46 @@ bool collinear(const Vec3& p, const Vec3& q, const Vec3& r) {
   return true;
 }
 
-std::optional<Vec3> slide_on_flat_boundary(const mesh::TetMesh& m, const BoundaryIndex& boundary, VertId v,
-                                           std::span<const Index> tris, std::span<const TetId> ball,
-                                           const Vec3& p) {
+std::optional<FlatBoundary> FlatBoundary::at(const mesh::TetMesh& m, const BoundaryIndex& boundary, VertId v,
+                                             std::span<const Index> tris, std::span<const TetId> ball) {
   const int dim = m.vert_class[v].dim;
   if ((dim != 1 && dim != 2) || tris.empty() || !flat_per_face(m, tris)) return std::nullopt;
+  FlatBoundary f;
+  f.plane_ = dim == 2;
+  if (f.plane_) {
+    const auto& ref = m.tris[tris[0]].verts;
+    f.a_ = m.coords[ref[0]], f.b_ = m.coords[ref[1]], f.c_ = m.coords[ref[2]];
+    if (!((f.b_ - f.a_).cross(f.c_ - f.a_).squaredNorm() > 0)) return std::nullopt;
+  } else {
+    std::array<VertId, 2> ends{kNone, kNone};
+    int found = 0;
+    for (TetId t : ball)
+      for (VertId w : m.tet2verts[t])
+        if (w != v && w != ends[0] && found < 2 && boundary.find_edge(v, w) != kNone) ends[found++] = w;
+    if (found != 2 || !collinear(m.coords[ends[0]], m.coords[v], m.coords[ends[1]])) return std::nullopt;
+    f.a_ = m.coords[ends[0]], f.b_ = m.coords[ends[1]], f.c_ = m.coords[v];
+  }
   // Coordinates every point of the plane or line shares are copied, so
   // that rounding cannot take the point off it.
-  auto snap = [](Vec3 x, std::span<const Vec3> on) {
-    for (int k = 0; k < 3; ++k)
-      if (std::all_of(on.begin(), on.end(), [&](const Vec3& y) { return y[k] == on[0][k]; })) x[k] = on[0][k];
-    return x;
-  };
-  if (dim == 2) {
-    const auto& ref = m.tris[tris[0]].verts;
-    const Vec3 &a = m.coords[ref[0]], &b = m.coords[ref[1]], &c = m.coords[ref[2]];
-    const Vec3 n = (b - a).cross(c - a);
-    if (!(n.squaredNorm() > 0)) return std::nullopt;
-    const std::array<Vec3, 4> on{a, b, c, m.coords[v]};
-    const Vec3 x = snap(p - n * ((p - a).dot(n) / n.squaredNorm()), on);
-    if (predicates::orient3d(a.data(), b.data(), c.data(), x.data()) != 0) return std::nullopt;
-    return x;
+  const Vec3& x = m.coords[v];
+  for (int k = 0; k < 3; ++k)
+    f.fixed_[static_cast<std::size_t>(k)] = f.b_[k] == f.a_[k] && f.c_[k] == f.a_[k] && x[k] == f.a_[k];
+  return f;
+}
+
+std::optional<Vec3> FlatBoundary::slide(const Vec3& p) const {
+  Vec3 x;
+  if (plane_) {
+    const Vec3 n = (b_ - a_).cross(c_ - a_);
+    x = p - n * ((p - a_).dot(n) / n.squaredNorm());
+  } else {
+    const Vec3 d = b_ - a_;
+    x = a_ + d * ((p - a_).dot(d) / d.squaredNorm());
   }
-  std::array<VertId, 2> ends{kNone, kNone};
-  int found = 0;
-  for (TetId t : ball)
-    for (VertId w : m.tet2verts[t])
-      if (w != v && w != ends[0] && found < 2 && boundary.find_edge(v, w) != kNone) ends[found++] = w;
-  if (found != 2) return std::nullopt;
-  const Vec3 &a = m.coords[ends[0]], &b = m.coords[ends[1]];
-  if (!collinear(a, m.coords[v], b)) return std::nullopt;
-  const Vec3 d = b - a;
-  const std::array<Vec3, 3> on{a, b, m.coords[v]};
-  const Vec3 x = snap(a + d * ((p - a).dot(d) / d.squaredNorm()), on);
-  if (!collinear(a, x, b)) return std::nullopt;
-  return x;
+  for (int k = 0; k < 3; ++k)
+    if (fixed_[static_cast<std::size_t>(k)]) x[k] = a_[k];
+  const bool on = plane_ ? predicates::orient3d(a_.data(), b_.data(), c_.data(), x.data()) == 0 : collinear(a_, x, b_);
+  return on ? std::optional<Vec3>(x) : std::nullopt;
 }
 
 double tet_quality_at(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {

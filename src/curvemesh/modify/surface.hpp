@@ -116,17 +116,29 @@ bool flat_per_face(const mesh::TetMesh& m, std::span<const Index> tris);
 bool collinear(const Vec3& p, const Vec3& q, const Vec3& r);
 
 /// Where a boundary vertex may go without a model and leave the surface the
-/// same point set: the point nearest `p` on the plane of its triangles (a
-/// vertex on a model face) or on the line through its two neighbours along
-/// its model edge (both ends found in m.edges), when that plane or line is
-/// exactly flat around it (flat_per_face, collinear) and the point lies on
-/// it exactly once rounded. That holds for planes and lines parallel to the
-/// coordinate axes, whose fixed coordinates are copied exactly, and seldom
-/// otherwise; nothing when it does not (or v is not on a model edge or
-/// face). `tris` are v's triangles (tris_through), `ball` its tets.
-std::optional<Vec3> slide_on_flat_boundary(const mesh::TetMesh& m, const BoundaryIndex& boundary, VertId v,
-                                           std::span<const Index> tris, std::span<const TetId> ball,
-                                           const Vec3& p);
+/// same point set: the plane of its triangles (a vertex on a model face) or
+/// the line through its two neighbours along its model edge (both ends
+/// found in m.edges), when that plane or line is exactly flat around it
+/// (flat_per_face, collinear). Found once per vertex; then each candidate
+/// position is a projection and an exact test.
+class FlatBoundary {
+ public:
+  /// Nothing when v is not on a model edge or face or its surface is not
+  /// exactly flat there. `tris` are v's triangles (tris_through), `ball` its
+  /// tets.
+  static std::optional<FlatBoundary> at(const mesh::TetMesh& m, const BoundaryIndex& boundary, VertId v,
+                                        std::span<const Index> tris, std::span<const TetId> ball);
+  /// The point nearest p on the plane (line), when it lies on it exactly
+  /// once rounded. That holds for planes and lines parallel to the
+  /// coordinate axes, whose fixed coordinates are copied exactly, and
+  /// seldom otherwise.
+  std::optional<Vec3> slide(const Vec3& p) const;
+
+ private:
+  bool plane_ = true;
+  Vec3 a_, b_, c_;  // the plane's reference triangle, or the line's ends (a_, b_)
+  std::array<bool, 3> fixed_{};  // coordinates every point of it shares (those of a_)
+};
 
 /// Face f of a tet with vertices tv, in the order of mesh::kFaceVerts
 /// (its normal out of the tet).

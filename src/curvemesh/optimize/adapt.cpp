@@ -184,7 +184,7 @@ bool relocate_on_model(modify::MeshEditor& ed, modify::Cavity& cav, const modify
 
 // Region vertices move freely; with flat_boundary (no model), boundary
 // vertices move within an exactly flat face or straight model edge
-// (modify::slide_on_flat_boundary), so the surface stays as it was. Their
+// (modify::FlatBoundary), so the surface stays as it was. Their
 // parameters are then unknown (NaN).
 bool relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::BoundaryIndex& boundary,
               bool flat_boundary, const MetricField& f, VertId v, std::vector<TetId>& ball,
@@ -195,9 +195,11 @@ bool relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::Boundar
   if (dim != 3 && (!flat_boundary || dim < 1)) return false;
   mesh::collect_ball(m, v, ball);
   thread_local std::vector<Index> tris;
+  std::optional<modify::FlatBoundary> flat;
   if (dim != 3) {
     modify::tris_through(m, boundary, v, ball, tris);
-    if (!modify::slide_on_flat_boundary(m, boundary, v, tris, ball, m.coords[v])) return false;
+    flat = modify::FlatBoundary::at(m, boundary, v, tris, ball);
+    if (!flat) return false;
   }
   cav.reset(ed);
   ring.clear();
@@ -226,7 +228,7 @@ bool relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::Boundar
   for (const Vec3& goal : {centroid, unit})
     for (double w : {1.0, 0.5, 0.25}) {
       std::optional<Vec3> x = old + w * (goal - old);
-      if (dim != 3) x = modify::slide_on_flat_boundary(m, boundary, v, tris, ball, *x);
+      if (flat) x = flat->slide(*x);
       if (!x) continue;
       m.coords[v] = *x;
       const double q = quality.min(m);

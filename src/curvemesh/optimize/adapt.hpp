@@ -29,7 +29,7 @@
 // may, where the surface is exactly flat around them and, on a model edge,
 // exactly straight: collapses that keep the surface
 // (modify::CollapsePlan::keeps_surface) and moves within the plane or line
-// (modify::slide_on_flat_boundary), as on the faces of a box. Without that,
+// (modify::FlatBoundary), as on the faces of a box. Without that,
 // a boundary vertex next to a fine region keeps its short edges.
 // With a model (options.model, its tags those of the mesh's
 // classification), points split on boundary edges go onto the model and
