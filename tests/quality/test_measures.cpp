@@ -432,6 +432,36 @@ TEST(ShapeMeasure, VolumeAgreesAcrossRulesAndBezier) {
     }
 }
 
+TEST(ShapeMeasure, FromBezierCoefficientsMatchesTheNodalRule) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int inverted = 0;
+  for (int p = 1; p <= kMaxBezierOrder; ++p)
+    for (int trial = 0; trial < 40; ++trial) {
+      auto nodes = p_nodes(p, kRegular);
+      // Up to strongly folded elements (I < 0), where the least value and
+      // the mean disagree in sign.
+      const double amplitude = 0.05 * (trial % 20);
+      for (std::size_t n = 4; n < nodes.size(); ++n) nodes[n] += amplitude * Vec3(u(rng), u(rng), u(rng));
+      if (p == 1 && trial % 2) std::swap(nodes[0], nodes[1]);
+      const ShapeMeasure direct = shape_measure(p, nodes);
+      const ShapeMeasure bezier = shape_measure_from_bezier(p, jacobian_bezier_coefficients(p, nodes));
+      const double scale = std::max(std::abs(direct.max_detj), std::abs(direct.min_detj));
+      EXPECT_EQ(bezier.num_points, direct.num_points);
+      EXPECT_NEAR(bezier.min_detj, direct.min_detj, 1e-12 * scale) << p << " " << trial;
+      EXPECT_NEAR(bezier.max_detj, direct.max_detj, 1e-12 * scale) << p << " " << trial;
+      EXPECT_NEAR(bezier.volume, direct.volume, 1e-13 * scale) << p << " " << trial;
+      // I = min / |mean|: its error is the inputs' relative to the mean.
+      const double mean = std::abs(6 * direct.volume);
+      EXPECT_NEAR(bezier.measure, direct.measure, 1e-11 * scale / mean * (1 + std::abs(direct.measure)))
+          << p << " " << trial;
+      inverted += direct.measure < 0;
+    }
+  EXPECT_GT(inverted, 5);  // the comparison covered folded elements too
+  EXPECT_THROW(shape_measure_from_bezier(3, std::vector<double>(20, 1.0)), std::invalid_argument);
+  EXPECT_THROW(shape_measure_from_bezier(0, std::vector<double>(1, 1.0)), std::invalid_argument);
+}
+
 TEST(ShapeMeasure, OnMeshAndInputChecks) {
   mesh::TetMesh m;
   for (const Vec3& x : kCorner) m.add_vert(x);

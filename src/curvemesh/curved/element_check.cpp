@@ -47,7 +47,7 @@ bool has_any_node(const mesh::TetMesh& m, const std::array<VertId, 4>& v) {
 }  // namespace
 
 ElementCheck check_element(int order, std::span<const Vec3> nodes, const Acceptance& acceptance,
-                           bool exact_measure) {
+                           bool exact_measure, bool locate_minimum) {
   ElementCheck c;
   if (order == 1 || is_straight(order, nodes)) {
     if (predicates::orient3d(nodes[0].data(), nodes[1].data(), nodes[2].data(), nodes[3].data()) <= 0) {
@@ -59,7 +59,11 @@ ElementCheck check_element(int order, std::span<const Vec3> nodes, const Accepta
     }
     return c;
   }
-  quality::ValidityReport r = quality::certify_jacobian(order, nodes);
+  std::array<double, quality::simplex_count(quality::kMaxJacobianDegree)> coefs;
+  const std::span<double> jacobian(coefs.data(), std::size_t(quality::simplex_count(3 * (order - 1))));
+  quality::ValidityOptions first;
+  if (!locate_minimum) first.locate_splits = 0;
+  quality::ValidityReport r = quality::certify_jacobian(order, nodes, first, jacobian);
   // The first certified bound can be loose; where it decides whether the
   // element is acceptable, refine until it is within 1% of the minimum.
   if (r.verdict == quality::Validity::kValid && r.scaled_jacobian_lower < 2 * acceptance.min_scaled_jacobian) {
@@ -75,7 +79,7 @@ ElementCheck check_element(int order, std::span<const Vec3> nodes, const Accepta
     c.measure = c.scaled_jacobian;
     c.measure_exact = false;
   } else {
-    c.measure = quality::shape_measure(order, nodes).measure;
+    c.measure = quality::shape_measure_from_bezier(order, jacobian).measure;
   }
   c.acceptable = c.verdict == quality::Validity::kValid && c.scaled_jacobian >= acceptance.min_scaled_jacobian &&
                  c.measure >= acceptance.min_measure;
@@ -153,7 +157,10 @@ ElementCheck check_straight(const mesh::TetMesh& m, TetId t, const Acceptance& a
 
 ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& acceptance, bool exact_measure) {
   if (plainly_straight(m, t)) return check_straight(m, t, acceptance);
-  return check_element(m.high_order.order(), mesh::gather_tet_nodes(m, t), acceptance, exact_measure);
+  std::array<Vec3, mesh::kMaxTetNodes> buffer;
+  const std::span<Vec3> nodes(buffer.data(), nodes_per_tet(m.high_order.order()));
+  mesh::gather_tet_nodes(m, m.tet2verts[t], nodes);
+  return check_element(m.high_order.order(), nodes, acceptance, exact_measure);
 }
 
 MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures,
@@ -182,7 +189,9 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
         checks[t] = check_straight(m, tet, acceptance);
         continue;
       }
-      const std::vector<Vec3> nodes = mesh::gather_tet_nodes(m, tet);
+      std::array<Vec3, mesh::kMaxTetNodes> buffer;
+      const std::span<Vec3> nodes(buffer.data(), per_tet);
+      mesh::gather_tet_nodes(m, m.tet2verts[tet], nodes);
       const ElementCheck* known = reuse ? reuse->find(nodes) : nullptr;
       if (known && (known->measure_exact || !exact_measures))
         checks[t] = *known;

@@ -59,8 +59,13 @@ struct ElementCheck {
 /// already clears min_measure, I cannot decide anything: unless asked for,
 /// it is then not computed (measure = the bound, measure_exact = false),
 /// which halves the cost of checking a curved order-3 tet.
+/// For an element that is not valid, `locate_minimum` spends further
+/// subdivisions moving `where` toward the least det J (and tightening the
+/// negative bound); without it `where` is the first point found with
+/// det J <= 0, which costs several times less: what judging the many
+/// candidate configurations of a repair needs.
 ElementCheck check_element(int order, std::span<const Vec3> nodes, const Acceptance& acceptance,
-                           bool exact_measure = false);
+                           bool exact_measure = false, bool locate_minimum = true);
 
 /// check_element on tet t of m (its stored nodes; straight where none).
 ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& acceptance, bool exact_measure = false);

@@ -312,37 +312,93 @@ void HighOrderNodes::erase_face(VertId a, VertId b, VertId c) {
 
 namespace {
 
-// Shared by tets and triangles: fills nodes from vertex ids and multi-indices.
+// Where each stored entity's nodes go in an element's node list, so that a
+// gather looks the table up once per edge and per face rather than once per
+// node: on a big mesh those lookups are cache misses, and they are most of
+// what checking a curved mesh costs.
+struct GatherEntity {
+  int count = 0;                           // 2: an edge, 3: a face
+  std::array<int, 3> local{};              // its local vertices, as the multi-indices list them
+  std::vector<std::pair<int, int>> slots;  // (node, position in the entity's stored list)
+};
+
 template <std::size_t K>
-std::vector<Vec3> gather_nodes(const TetMesh& m, const std::array<VertId, K>& v,
-                               const std::vector<std::array<int, K>>& indices) {
-  const int p = m.high_order.order();
-  std::vector<Vec3> out(indices.size());
-  std::array<Vec3, kMaxOrder * kMaxOrder> buf;
+std::vector<GatherEntity> make_gather_plan(int p, const std::vector<std::array<int, K>>& indices) {
+  std::vector<GatherEntity> plan;
+  const auto& interior = cached_interior_indices(p);
   for (std::size_t n = 0; n < indices.size(); ++n) {
     const auto& idx = indices[n];
-    int nz[K];
+    std::array<int, 4> nz{};
     int count = 0;
+    for (std::size_t k = 0; k < K; ++k)
+      if (idx[k] != 0) nz[static_cast<std::size_t>(count++)] = static_cast<int>(k);
+    // Vertices are copied, a tet's interior nodes are linear.
+    if (count != 2 && count != 3) continue;
+    const std::array<int, 3> local{nz[0], nz[1], count == 3 ? nz[2] : -1};
+    int position = idx[static_cast<std::size_t>(nz[1])] - 1;
+    if (count == 3) {
+      const std::array<int, 3> rel{idx[static_cast<std::size_t>(nz[0])], idx[static_cast<std::size_t>(nz[1])],
+                                   idx[static_cast<std::size_t>(nz[2])]};
+      position = static_cast<int>(std::find(interior.begin(), interior.end(), rel) - interior.begin());
+    }
+    auto it = std::find_if(plan.begin(), plan.end(), [&](const GatherEntity& e) { return e.local == local; });
+    if (it == plan.end()) it = plan.insert(plan.end(), GatherEntity{count, local, {}});
+    it->slots.emplace_back(static_cast<int>(n), position);
+  }
+  return plan;
+}
+
+const std::vector<GatherEntity>& tet_gather_plan(int p) {
+  static const std::array<std::vector<GatherEntity>, kMaxOrder + 1> cache = [] {
+    std::array<std::vector<GatherEntity>, kMaxOrder + 1> c;
+    for (int q = 1; q <= kMaxOrder; ++q) c[static_cast<std::size_t>(q)] = make_gather_plan<4>(q, cached_tet_indices(q));
+    return c;
+  }();
+  return cache[static_cast<std::size_t>(p)];
+}
+
+const std::vector<GatherEntity>& tri_gather_plan(int p) {
+  static const std::array<std::vector<GatherEntity>, kMaxOrder + 1> cache = [] {
+    std::array<std::vector<GatherEntity>, kMaxOrder + 1> c;
+    for (int q = 1; q <= kMaxOrder; ++q) c[static_cast<std::size_t>(q)] = make_gather_plan<3>(q, cached_tri_indices(q));
+    return c;
+  }();
+  return cache[static_cast<std::size_t>(p)];
+}
+
+// Shared by tets and triangles: fills nodes from vertex ids and multi-indices.
+template <std::size_t K>
+void gather_nodes(const TetMesh& m, const std::array<VertId, K>& v, const std::vector<std::array<int, K>>& indices,
+                  const std::vector<GatherEntity>& plan, std::span<Vec3> out) {
+  CM_ASSERT_OP(out.size(), ==, indices.size());
+  const int p = m.high_order.order();
+  // Stored nodes first; a bit per node says which ones were found.
+  static_assert(kMaxTetNodes <= 64);
+  std::uint64_t stored = 0;
+  std::array<Vec3, kMaxOrder * kMaxOrder> buf;
+  for (const GatherEntity& e : plan) {
+    const bool found = e.count == 2 ? m.high_order.get_edge(v[e.local[0]], v[e.local[1]], buf.data())
+                                    : m.high_order.get_face(v[e.local[0]], v[e.local[1]], v[e.local[2]], buf.data());
+    if (!found) continue;
+    for (const auto& [n, at] : e.slots) {
+      out[static_cast<std::size_t>(n)] = buf[static_cast<std::size_t>(at)];
+      stored |= std::uint64_t{1} << n;
+    }
+  }
+  for (std::size_t n = 0; n < indices.size(); ++n) {
+    if (stored >> n & 1) continue;
+    const auto& idx = indices[n];
+    int nonzero = 0;
+    std::size_t last = 0;
     Vec3 linear = Vec3::Zero();
     for (std::size_t k = 0; k < K; ++k)
       if (idx[k] != 0) {
-        nz[count++] = static_cast<int>(k);
+        ++nonzero;
+        last = k;
         linear += (static_cast<double>(idx[k]) / p) * m.coords[v[k]];
       }
-    out[n] = linear;
-    if (count == 1) {
-      out[n] = m.coords[v[nz[0]]];
-    } else if (count == 2) {
-      if (m.high_order.get_edge(v[nz[0]], v[nz[1]], buf.data())) out[n] = buf[idx[nz[1]] - 1];
-    } else if (count == 3) {
-      if (m.high_order.get_face(v[nz[0]], v[nz[1]], v[nz[2]], buf.data())) {
-        const auto& interior = cached_interior_indices(p);
-        const std::array<int, 3> rel{idx[nz[0]], idx[nz[1]], idx[nz[2]]};
-        out[n] = buf[std::find(interior.begin(), interior.end(), rel) - interior.begin()];
-      }
-    }
+    out[n] = nonzero == 1 ? m.coords[v[last]] : linear;
   }
-  return out;
 }
 
 template <std::size_t K>
@@ -388,16 +444,24 @@ void scatter_nodes(TetMesh& m, const std::array<VertId, K>& v,
 
 }  // namespace
 
-std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t) {
-  return gather_nodes<4>(m, m.tet2verts[t], cached_tet_indices(m.high_order.order()));
-}
+std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t) { return gather_tet_nodes(m, m.tet2verts[t]); }
 
 std::vector<Vec3> gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts) {
-  return gather_nodes<4>(m, verts, cached_tet_indices(m.high_order.order()));
+  std::vector<Vec3> out(cached_tet_indices(m.high_order.order()).size());
+  gather_tet_nodes(m, verts, out);
+  return out;
+}
+
+void gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts, std::span<Vec3> out) {
+  const int p = m.high_order.order();
+  gather_nodes<4>(m, verts, cached_tet_indices(p), tet_gather_plan(p), out);
 }
 
 std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri) {
-  return gather_nodes<3>(m, tri, cached_tri_indices(m.high_order.order()));
+  const int p = m.high_order.order();
+  std::vector<Vec3> out(cached_tri_indices(p).size());
+  gather_nodes<3>(m, tri, cached_tri_indices(p), tri_gather_plan(p), out);
+  return out;
 }
 
 void scatter_tet_nodes(TetMesh& m, TetId t, std::span<const Vec3> nodes) {

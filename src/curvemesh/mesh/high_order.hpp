@@ -2,6 +2,7 @@
 // Storage of high-order (Lagrange) nodes per mesh edge and per mesh face, and
 // the node order of order-p elements inside curvemesh.
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <optional>
@@ -12,6 +13,8 @@
 namespace cm::mesh {
 
 inline constexpr int kMaxOrder = 3;
+/// Nodes of an order-kMaxOrder tet: a buffer that fits any tet.
+inline constexpr std::size_t kMaxTetNodes = std::size_t((kMaxOrder + 1) * (kMaxOrder + 2) * (kMaxOrder + 3) / 6);
 
 /// Barycentric multi-indices (i0,i1,i2,i3), i0+..+i3 = p, of the nodes of an
 /// order-p Lagrange tet in curvemesh's internal order: the 4 vertices; then for
@@ -104,6 +107,9 @@ std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t);
 /// The same for a tet given by its vertices (it need not be in the mesh: a
 /// tet an operator would create).
 std::vector<Vec3> gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts);
+/// The same into out, whose size must be the order's node count (no
+/// allocation: what the checks of a curved mesh call per tet).
+void gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts, std::span<Vec3> out);
 /// All nodes of triangle (a,b,c) in the order of tri_node_indices(order).
 std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri);
 

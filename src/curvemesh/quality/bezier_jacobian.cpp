@@ -476,14 +476,21 @@ std::vector<Vec3> geometry_control_points(int order, std::span<const Vec3> nodes
 }
 
 ValidityReport certify_jacobian(int order, std::span<const Vec3> nodes,
-                                const ValidityOptions& options) {
+                                const ValidityOptions& options, std::span<double> coefficients) {
   check_input(order, nodes);
-  if (order == 1) return certify_linear(nodes);
+  if (!coefficients.empty() && static_cast<int>(coefficients.size()) != simplex_count(3 * (order - 1)))
+    throw std::invalid_argument(fmt::format("det J of an order-{} tet has {} Bernstein coefficients, not {}", order,
+                                            simplex_count(3 * (order - 1)), coefficients.size()));
+  if (order == 1) {
+    if (!coefficients.empty()) coefficients[0] = (nodes[1] - nodes[0]).cross(nodes[2] - nodes[0]).dot(nodes[3] - nodes[0]);
+    return certify_linear(nodes);
+  }
 
   const OrderTables& ot = order_tables(order);
   const DegreeTables& dt = degree_tables(3 * (order - 1));
   std::array<double, kMaxCoefs> root;
   const double err0 = compute_coefficients(ot, nodes, root.data());
+  std::copy(root.begin(), root.begin() + static_cast<std::ptrdiff_t>(coefficients.size()), coefficients.begin());
   const auto [lo_it, hi_it] = std::minmax_element(root.begin(), root.begin() + dt.num_coefs);
   const double lo = *lo_it;
   const double hi = *hi_it;

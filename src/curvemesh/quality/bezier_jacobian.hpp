@@ -115,8 +115,11 @@ std::vector<Vec3> geometry_control_points(int order, std::span<const Vec3> nodes
 /// (std::invalid_argument otherwise).
 /// Cost: one coefficient computation, plus O(q^4) per bisection when the
 /// coefficients do not settle the question at once.
+/// A non-empty `coefficients` (size simplex_count(3(order-1)), else
+/// std::invalid_argument) receives the coefficients on the whole element, as
+/// jacobian_bezier_coefficients gives them, at no extra cost.
 ValidityReport certify_jacobian(int order, std::span<const Vec3> nodes,
-                                const ValidityOptions& options = {});
+                                const ValidityOptions& options = {}, std::span<double> coefficients = {});
 
 /// certify_jacobian on tet t of m, at the mesh's order (mesh::gather_tet_nodes).
 ValidityReport certify_tet(const mesh::TetMesh& m, TetId t, const ValidityOptions& options = {});

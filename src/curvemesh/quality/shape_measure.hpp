@@ -42,6 +42,17 @@ struct ShapeMeasure {
 /// per (order, n).
 ShapeMeasure shape_measure(int order, std::span<const Vec3> nodes, int points_per_direction = 0);
 
+/// The same I from the Bernstein coefficients of det J
+/// (jacobian_bezier_coefficients, rank order of degree 3(p-1)), at the
+/// points of the same default rule: equal to shape_measure(order, nodes) up to
+/// rounding. The volume is then exactly the mean coefficient over 6. What the
+/// checks of curved meshes use, since the certification computed the
+/// coefficients already: one (points x coefficients) product, about half the
+/// work of assembling the Jacobian at every point.
+/// Precondition: 1 <= order <= kMaxBezierOrder, coefs.size() ==
+/// simplex_count(3(order-1)) (std::invalid_argument otherwise).
+ShapeMeasure shape_measure_from_bezier(int order, std::span<const double> jacobian_coefs);
+
 /// shape_measure of tet t of m at the mesh's order.
 ShapeMeasure shape_measure(const mesh::TetMesh& m, TetId t, int points_per_direction = 0);
 

@@ -6,7 +6,9 @@
 // candidates again on the next pass. Results are remembered keyed by the
 // nodes themselves, compared exactly, so a temporary node override, a
 // scratch vertex reusing an id or a moved vertex can never hit a stale one.
-#include <vector>
+// Candidates are ranked by their scores, not by where they fail, so an
+// invalid one is not located further (check_element's locate_minimum).
+#include <span>
 
 #include "curvemesh/curved/element_check.hpp"
 
@@ -16,13 +18,13 @@ class CheckMemo {
  public:
   CheckMemo(int order, const Acceptance& acceptance) : table_(order), acceptance_(acceptance) {}
 
-  ElementCheck operator()(const std::vector<Vec3>& nodes) {
+  ElementCheck operator()(std::span<const Vec3> nodes) {
     if (const ElementCheck* known = table_.find(nodes)) {
       ++hits_;
       return *known;
     }
     ++misses_;
-    const ElementCheck c = check_element(table_.order(), nodes, acceptance_);
+    const ElementCheck c = check_element(table_.order(), nodes, acceptance_, false, false);
     // A bounded memory: start afresh rather than track ages.
     if (table_.size() >= kMaxEntries) table_.clear();
     table_.add(nodes, c);

@@ -22,6 +22,7 @@
 #include "curvemesh/curved/element_check.hpp"
 #include "curvemesh/curved/nodes.hpp"
 #include "curvemesh/curved/repair.hpp"
+#include "curvemesh/mesh/high_order.hpp"
 #include "curvemesh/mesh/topology.hpp"
 #include "curvemesh/modify/boundary_swap.hpp"
 #include "curvemesh/modify/collapse.hpp"
@@ -151,6 +152,7 @@ class Repairer {
         boundary_(m),
         placer_(m, model),
         order_(m.high_order.order()),
+        nodes_per_tet_(std::size_t((order_ + 1) * (order_ + 2) * (order_ + 3) / 6)),
         memo_(order_, o.acceptance) {
     modify::mark_boundary_faces(ed_);
     ed_.set_hook([this](const mesh::TetMesh&, std::span<const TetId> created) { after_edit(created); });
@@ -169,7 +171,10 @@ class Repairer {
 
  private:
   ElementCheck check(const Verts& v) const {
-    return memo_(mesh::gather_tet_nodes(m_, v));
+    std::array<Vec3, mesh::kMaxTetNodes> buffer;
+    const std::span<Vec3> nodes(buffer.data(), nodes_per_tet_);
+    mesh::gather_tet_nodes(m_, v, nodes);
+    return memo_(nodes);
   }
   Outcome evaluate(std::span<const Verts> tets) const {
     Outcome out;
@@ -234,6 +239,7 @@ class Repairer {
   modify::Cavity cav_;
   NodePlacer placer_;
   int order_;
+  std::size_t nodes_per_tet_;
   mutable CheckMemo memo_;
   RepairStats st_;
   std::size_t budget_ = 0;
