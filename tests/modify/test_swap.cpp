@@ -4,6 +4,9 @@
 // adjacency, orientation, volume, boundary triangles untouched, regions.
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <limits>
+#include <map>
 #include <random>
 #include <set>
 
@@ -12,6 +15,7 @@
 #include "curvemesh/modify/marks.hpp"
 #include "curvemesh/modify/measure.hpp"
 #include "curvemesh/modify/relocate.hpp"
+#include "curvemesh/modify/ring_triangulation.hpp"
 #include "curvemesh/modify/swap.hpp"
 #include "curvemesh/optimize/improve.hpp"
 #include "invariants.hpp"
@@ -158,6 +162,58 @@ TEST(Swap, OnADelaunayMeshOfRandomPointsEveryShellSizeWorks) {
   EXPECT_GT(moves, 200);
   EXPECT_GE(shell_sizes.size(), 4u);  // 3-2, 4-4, 5-6, 6-8 at least
   expect_invariants(ed, volume);
+}
+
+// The best worst triangle of a polygon, by enumerating every triangulation:
+// the edge (i, j) with apex k, then the two sides.
+double brute_force_ring(int i, int j, const std::function<double(int, int, int)>& f) {
+  if (j - i < 2) return std::numeric_limits<double>::infinity();
+  double best = -std::numeric_limits<double>::infinity();
+  for (int k = i + 1; k < j; ++k)
+    best = std::max(best, std::min({f(i, k, j), brute_force_ring(i, k, f), brute_force_ring(k, j, f)}));
+  return best;
+}
+
+TEST(RingTriangulation, IsOptimalAndTheFloorChangesNothing) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int n = 3; n <= 9; ++n)
+    for (int trial = 0; trial < 30; ++trial) {
+      // A triangle's value is the min of two "tets", as in edge removal.
+      std::map<std::array<int, 3>, std::array<double, 2>> values;
+      for (int i = 0; i < n; ++i)
+        for (int k = i + 1; k < n; ++k)
+          for (int j = k + 1; j < n; ++j) values[{i, k, j}] = {u(rng), u(rng)};
+      const auto exact = [&](int i, int k, int j) {
+        const auto& v = values.at({i, k, j});
+        return std::min(v[0], v[1]);
+      };
+      int full_calls = 0, floored_second = 0;
+      const RingTriangulation plain = triangulate_ring(n, [&](int i, int k, int j) {
+        ++full_calls;
+        return exact(i, k, j);
+      });
+      const RingTriangulation floored = triangulate_ring(n, [&](int i, int k, int j, double floor) {
+        const auto& v = values.at({i, k, j});
+        if (v[0] <= floor) return v[0];
+        ++floored_second;
+        return std::min(v[0], v[1]);
+      });
+      EXPECT_DOUBLE_EQ(plain.worst, brute_force_ring(0, n - 1, exact)) << n;
+      ASSERT_EQ(floored.count, n - 2);
+      EXPECT_EQ(floored.worst, plain.worst);
+      EXPECT_EQ(floored.triangles, plain.triangles);
+      EXPECT_LE(floored_second, full_calls);
+      // The triangles listed reach the worst value they claim.
+      double worst = std::numeric_limits<double>::infinity();
+      for (int t = 0; t < plain.count; ++t) {
+        const auto& tri = plain.triangles[static_cast<std::size_t>(t)];
+        worst = std::min(worst, exact(tri[0], tri[1], tri[2]));
+      }
+      EXPECT_EQ(worst, plain.worst);
+    }
+  EXPECT_EQ(triangulate_ring(2, [](int, int, int) { return 1.0; }).count, 0);
+  EXPECT_EQ(triangulate_ring(kMaxRing + 1, [](int, int, int) { return 1.0; }).count, 0);
 }
 
 TEST(Swap, RefusalsAreValuesAndChangeNothing) {

@@ -108,9 +108,10 @@ BoundarySwap plan_boundary_edge_swap(MeshEditor& ed, Cavity& cav, const Boundary
     return ccw_from_a ? std::array<std::array<VertId, 4>, 2>{{{ri, rk, rj, a}, {rk, ri, rj, b}}}
                       : std::array<std::array<VertId, 4>, 2>{{{rk, ri, rj, a}, {ri, rk, rj, b}}};
   };
-  const RingTriangulation best = triangulate_ring(k + 1, [&](int i, int kk, int j) {
+  const RingTriangulation best = triangulate_ring(k + 1, [&](int i, int kk, int j, double floor) {
     const auto tv = tets_of(i, kk, j);
-    return std::min(measure(m, tv[0], context), measure(m, tv[1], context));
+    const double one = measure(m, tv[0], context);
+    return one <= floor ? one : std::min(one, measure(m, tv[1], context));
   });
   if (!(best.worst > 0)) return refuse(plan, Refusal::kNotStarShaped);
   plan.after = best.worst;

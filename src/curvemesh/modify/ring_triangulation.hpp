@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <type_traits>
 
 namespace cm::modify {
 
@@ -24,19 +25,20 @@ struct RingTriangulation {
 /// each triangle measured at most once. 3 <= n <= kMaxRing (else an empty
 /// result). O(n³) measure calls at worst; pruned where a sub-polygon
 /// already cannot beat the best.
+/// A measure that takes a fourth argument, floor, is told the value it has
+/// to beat: where the triangle's true value is <= floor it may return any
+/// value <= floor (a measure that is a minimum over several tets can stop
+/// at the first one at or below it). The result is the same.
 template <class Measure>
 RingTriangulation triangulate_ring(int n, Measure&& measure) {
   RingTriangulation out;
   if (n < 3 || n > kMaxRing) return out;
-  constexpr double kUnset = -std::numeric_limits<double>::infinity();
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  double tri[kMaxRing][kMaxRing][kMaxRing];
-  for (int i = 0; i < n; ++i)
-    for (int k = i + 1; k < n; ++k)
-      for (int j = k + 1; j < n; ++j) tri[i][k][j] = kUnset;
   double best[kMaxRing][kMaxRing];
   int pick[kMaxRing][kMaxRing];
   for (int i = 0; i + 1 < n; ++i) best[i][i + 1] = kInf;
+  // Triangle (i, k, j) belongs to sub-polygon (i, j) alone, so each one is
+  // measured once without a table.
   for (int len = 2; len < n; ++len)
     for (int i = 0; i + len < n; ++i) {
       const int j = i + len;
@@ -45,8 +47,11 @@ RingTriangulation triangulate_ring(int n, Measure&& measure) {
       for (int k = i + 1; k < j; ++k) {
         const double side = std::min(best[i][k], best[k][j]);
         if (side <= best[i][j]) continue;
-        double& t = tri[i][k][j];
-        if (t == kUnset) t = measure(i, k, j);
+        double t;
+        if constexpr (std::is_invocable_v<Measure&, int, int, int, double>)
+          t = measure(i, k, j, best[i][j]);
+        else
+          t = measure(i, k, j);
         const double q = std::min(side, t);
         if (q > best[i][j]) {
           best[i][j] = q;

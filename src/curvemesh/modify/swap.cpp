@@ -65,9 +65,10 @@ Plan plan_edge_removal(MeshEditor& ed, Cavity& cav, VertId a, VertId b, TetId st
     return ccw_from_a ? std::array<std::array<VertId, 4>, 2>{{{ri, rj, rk, a}, {rj, ri, rk, b}}}
                       : std::array<std::array<VertId, 4>, 2>{{{rj, ri, rk, a}, {ri, rj, rk, b}}};
   };
-  const RingTriangulation best = triangulate_ring(n, [&](int i, int k, int j) {
+  const RingTriangulation best = triangulate_ring(n, [&](int i, int k, int j, double floor) {
     const auto tv = tets_of(i, k, j);
-    return std::min(tet_quality(m, tv[0]), tet_quality(m, tv[1]));
+    const double first = tet_quality(m, tv[0]);
+    return first <= floor ? first : std::min(first, tet_quality(m, tv[1]));
   });
   plan.after = best.worst;
   if (!(plan.after > 0)) {

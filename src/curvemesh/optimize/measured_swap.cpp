@@ -101,9 +101,10 @@ modify::Plan plan_measured_edge_removal(modify::MeshEditor& ed, modify::Cavity& 
   };
   // The ring's best triangulation; each triangle (i, k, j) of the ring is
   // measured once, through its two tets.
-  const modify::RingTriangulation best = modify::triangulate_ring(n, [&](int i, int k, int j) {
+  const modify::RingTriangulation best = modify::triangulate_ring(n, [&](int i, int k, int j, double floor) {
     const auto tv = tets_of(i, k, j);
-    return std::min(measure(m, tv[0], context), measure(m, tv[1], context));
+    const double first = measure(m, tv[0], context);
+    return first <= floor ? first : std::min(first, measure(m, tv[1], context));
   });
   plan.after = best.worst;
   if (!(plan.after > 0)) {
