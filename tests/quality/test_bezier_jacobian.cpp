@@ -401,6 +401,65 @@ TEST(BezierJacobian, NegativeOnlyInsideAnEdge) {
   EXPECT_NE(certify_jacobian(3, tangent).verdict, Validity::kValid);
 }
 
+// det J at vertex 0, in long double from the nodes as given: there the xi_j
+// derivative is the derivative of the 1D Lagrange interpolant along edge
+// (0, j) at its start.
+long double corner_det_exact(int p, const std::vector<Vec3>& nodes) {
+  static const std::array<std::array<long double, 4>, 4> kStart{{{0, 0, 0, 0},
+                                                                {-1, 1, 0, 0},
+                                                                {-3, 4, -1, 0},
+                                                                {-5.5L, 9, -4.5L, 1}}};
+  std::array<std::array<long double, 3>, 3> t{};
+  for (int j = 1; j <= 3; ++j) {
+    // The nodes of edge (0, j), from vertex 0.
+    int e = 0;
+    while (!((mesh::kTetEdges[static_cast<std::size_t>(e)][0] == 0 && mesh::kTetEdges[static_cast<std::size_t>(e)][1] == j) ||
+             (mesh::kTetEdges[static_cast<std::size_t>(e)][0] == j && mesh::kTetEdges[static_cast<std::size_t>(e)][1] == 0)))
+      ++e;
+    const bool from_zero = mesh::kTetEdges[static_cast<std::size_t>(e)][0] == 0;
+    std::array<Vec3, 4> along{};
+    along[0] = nodes[0];
+    for (int s = 1; s < p; ++s)
+      along[static_cast<std::size_t>(s)] =
+          nodes[static_cast<std::size_t>(4 + e * (p - 1) + (from_zero ? s - 1 : p - 1 - s))];
+    along[static_cast<std::size_t>(p)] = nodes[static_cast<std::size_t>(j)];
+    for (int c = 0; c < 3; ++c) {
+      long double d = 0;
+      for (int s = 0; s <= p; ++s)
+        d += kStart[static_cast<std::size_t>(p)][static_cast<std::size_t>(s)] *
+             (static_cast<long double>(along[static_cast<std::size_t>(s)][c]) - nodes[0][c]);
+      t[static_cast<std::size_t>(j - 1)][static_cast<std::size_t>(c)] = d;
+    }
+  }
+  return t[0][0] * (t[1][1] * t[2][2] - t[1][2] * t[2][1]) - t[0][1] * (t[1][0] * t[2][2] - t[1][2] * t[2][0]) +
+         t[0][2] * (t[1][0] * t[2][1] - t[1][1] * t[2][0]);
+}
+
+TEST(BezierJacobian, RoundingBoundHoldsFarFromTheOrigin) {
+  // Coordinates up to 1e6 on elements of size 1e-2..1: the rounding of the
+  // nodes themselves, then of the coefficients, against the stated bound.
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int p = 2; p <= 3; ++p) {
+    double worst = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+      const double size = std::pow(10.0, -2 * (trial % 2)) * (1 + 0.5 * u(rng));
+      const Vec3 offset = std::pow(10.0, trial % 7) * Vec3(u(rng), u(rng), u(rng));
+      auto nodes = similar(linear_nodes(p, random_good_tet(rng)), random_rotation(rng), size, offset);
+      for (std::size_t n = 4; n < nodes.size(); ++n) nodes[n] += 0.2 * size * Vec3(u(rng), u(rng), u(rng));
+      const double coef = jacobian_bezier_coefficients(p, nodes)[0];
+      const long double exact = corner_det_exact(p, nodes);
+      const double bound = certify_jacobian(p, nodes).rounding_bound;
+      const double error = static_cast<double>(std::abs(static_cast<long double>(coef) - exact));
+      EXPECT_LE(error, bound) << p << " " << trial;
+      worst = std::max(worst, error / bound);
+    }
+    // A priori, the bound is pessimistic (the worst error seen is about 1e-3
+    // of it for P2, 2e-4 for P3); much looser, it would certify little.
+    EXPECT_GT(worst, 1e-6) << p;
+  }
+}
+
 TEST(BezierJacobian, ZeroAtAVertexIsInvalid) {
   // P2 node of edge (0,1) at (0.5, 1/8, 1/8): det J = 1 - l1, zero at vertex 1.
   const auto nodes = bend_edge01(2, kUnit, Vec3(0, 0.125, 0.125));

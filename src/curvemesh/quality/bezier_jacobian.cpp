@@ -19,6 +19,7 @@ namespace {
 constexpr int kMaxNodes = simplex_count(kMaxBezierOrder);
 constexpr int kMaxDerivs = simplex_count(kMaxBezierOrder - 1);
 constexpr int kMaxCoefs = simplex_count(kMaxJacobianDegree);
+constexpr int kMaxPairSums = simplex_count(2 * (kMaxBezierOrder - 1));
 constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
 
 // Pairs of local vertices along which a subdomain can be bisected (i < j).
@@ -39,11 +40,23 @@ struct OrderTables {
   // d/dxi_j control point of rank b = p (c[plus[j][b]] - c[base[b]]).
   std::array<std::vector<int>, 3> plus;
   std::vector<int> base;
-  // Triple products, loop order (g, d, b) flattened as (g * nd + d) * nd + b:
-  // coefficient target[k] += weight[k] * det(D1[b], D2[g], D3[d]).
-  std::vector<int> target;
-  std::vector<double> weight;
-  int max_terms = 0;  // most products summed into one coefficient
+  // det J = D1 . (D2 x D3) in two products of Bernstein expansions (see
+  // compute_coefficients). First the cross products, of degree 2(p-1):
+  // pair_sum[s] += pair_weight * (D2[g] x D3[d]) for each entry of `pairs`.
+  struct PairTerm {
+    int g, d, s;
+    double weight;
+  };
+  struct DotTerm {
+    int b, s, target;
+    double weight;
+  };
+  std::vector<PairTerm> pairs;
+  // Then the dots: coefficient target += weight * D1[b] . pair_sum[s].
+  std::vector<DotTerm> dots;
+  int num_pair_sums = 0;  // Bernstein basis of degree 2(p-1)
+  int pair_terms = 0;     // most cross products summed into one pair sum
+  int dot_terms = 0;      // most dots summed into one coefficient
 };
 
 // Everything that depends only on the degree q of det J.
@@ -103,19 +116,33 @@ OrderTables build_order_tables(int p) {
     }
   }
 
-  // B_b B_g B_d = M(b) M(g) M(d) / M(b+g+d) B_{b+g+d} (M = multinomial).
-  std::vector<int> terms(static_cast<std::size_t>(t.num_coefs), 0);
-  for (const MultiIndex& g : derivs)
-    for (const MultiIndex& d : derivs)
-      for (const MultiIndex& b : derivs) {
-        MultiIndex sum;
-        for (int k = 0; k < 4; ++k) sum[k] = b[k] + g[k] + d[k];
-        const int rank = bernstein_rank(sum);
-        t.target.push_back(rank);
-        t.weight.push_back(multinomial(b) * multinomial(g) * multinomial(d) / multinomial(sum));
-        ++terms[static_cast<std::size_t>(rank)];
-      }
-  t.max_terms = *std::max_element(terms.begin(), terms.end());
+  // B_g B_d = M(g) M(d) / M(g+d) B_{g+d} (M = multinomial): for each degree
+  // the weights of a product expansion sum to one (Vandermonde), so every
+  // sum below is a convex combination.
+  t.num_pair_sums = simplex_count(2 * (p - 1));
+  std::vector<int> pair_count(static_cast<std::size_t>(t.num_pair_sums), 0);
+  std::vector<int> dot_count(static_cast<std::size_t>(t.num_coefs), 0);
+  for (std::size_t g = 0; g < derivs.size(); ++g)
+    for (std::size_t d = 0; d < derivs.size(); ++d) {
+      MultiIndex sum;
+      for (int k = 0; k < 4; ++k) sum[k] = derivs[g][k] + derivs[d][k];
+      const int s = bernstein_rank(sum);
+      t.pairs.push_back({static_cast<int>(g), static_cast<int>(d), s,
+                         multinomial(derivs[g]) * multinomial(derivs[d]) / multinomial(sum)});
+      ++pair_count[static_cast<std::size_t>(s)];
+    }
+  const auto pair_indices = bernstein_indices(2 * (p - 1));
+  for (std::size_t b = 0; b < derivs.size(); ++b)
+    for (std::size_t s = 0; s < pair_indices.size(); ++s) {
+      MultiIndex sum;
+      for (int k = 0; k < 4; ++k) sum[k] = derivs[b][k] + pair_indices[s][k];
+      const int rank = bernstein_rank(sum);
+      t.dots.push_back({static_cast<int>(b), static_cast<int>(s), rank,
+                        multinomial(derivs[b]) * multinomial(pair_indices[s]) / multinomial(sum)});
+      ++dot_count[static_cast<std::size_t>(rank)];
+    }
+  t.pair_terms = *std::max_element(pair_count.begin(), pair_count.end());
+  t.dot_terms = *std::max_element(dot_count.begin(), dot_count.end());
   return t;
 }
 
@@ -215,33 +242,41 @@ double compute_coefficients(const OrderTables& t, std::span<const Vec3> nodes, d
       d_inf = std::max(d_inf, d.cwiseAbs().maxCoeff());
       d_norm = std::max(d_norm, d.norm());
     }
+  // det J = sum_b D1_b B_b . (sum_g sum_d D2_g x D3_d B_g B_d): the inner
+  // product expanded first (nd^2 cross products into the degree-2(p-1)
+  // basis), then the dots (nd times that basis): 450 products for P3 where
+  // the triple products one by one would be 1000.
+  std::array<Vec3, kMaxPairSums> pair_sum;
+  std::fill(pair_sum.begin(), pair_sum.begin() + t.num_pair_sums, Vec3::Zero());
+  for (const auto& [g, d, s, w] : t.pairs)
+    pair_sum[static_cast<std::size_t>(s)] += w * deriv[1][static_cast<std::size_t>(g)].cross(deriv[2][static_cast<std::size_t>(d)]);
   std::fill(coefs, coefs + t.num_coefs, 0.0);
-  const int nd = t.num_derivs;
-  std::size_t k = 0;
-  for (int g = 0; g < nd; ++g)
-    for (int d = 0; d < nd; ++d) {
-      const Vec3 cross = deriv[1][g].cross(deriv[2][d]);
-      for (int b = 0; b < nd; ++b, ++k) coefs[t.target[k]] += t.weight[k] * deriv[0][b].dot(cross);
-    }
+  for (const auto& [b, s, target, w] : t.dots)
+    coefs[target] += w * deriv[0][static_cast<std::size_t>(b)].dot(pair_sum[static_cast<std::size_t>(s)]);
 
-  // Error budget, in the order the computation happens:
+  // Error budget, in the order the computation happens (|.| the 2-norm):
   // - control points: translation and the N-term products with lag2bez
   //   (whose entries are correctly rounded), |err| <= gamma(N+4) |L| max|y|;
-  // - derivative control points: a difference times p, |err| <= e_d each;
-  // - each triple product changes by at most (|d| + sqrt3 e_d)^3 - |d|^3 under
-  //   those input errors (Hadamard), and is computed within gamma(5) of the
-  //   sum of its 6 absolute terms (<= 6 max|d_i|^3);
-  // - the weighted sum into a coefficient is a convex combination (weights sum
-  //   to 1) of at most max_terms terms: gamma(max_terms + 2) max|det|.
+  // - derivative control points: a difference times p, |err| <= e_d per
+  //   coordinate; in exact arithmetic each D1 . (D2 x D3) then moves by at
+  //   most (|d| + sqrt3 e_d)^3 - |d|^3 (Hadamard), and convex combinations
+  //   of them by no more;
+  // - with those inputs, d = the largest |D|: a cross product is within
+  //   sqrt3 gamma(2) d^2, a pair sum (weights rounded twice, <= pair_terms
+  //   terms) within sqrt3 gamma(pair_terms + 3) d^2 more: e_pair in all;
+  // - a dot is within gamma(3) d (d^2 + e_pair) of the dot of what was
+  //   computed, which is within d e_pair of the exact one, and the sum into
+  //   a coefficient adds gamma(dot_terms + 3) of its terms' size.
   const double e_c = gamma(t.num_nodes + 4) * t.lag2bez_norm * node_scale;
   const double e_d = 2 * t.order * e_c + 2.02 * kUnitRoundoff * d_inf;
   const double pert = std::sqrt(3.0) * e_d;
   const double d_norm1 = d_norm + pert;
-  const double d_inf1 = d_inf + e_d;
   const double input_err = pert * (d_norm1 * d_norm1 + d_norm1 * d_norm + d_norm * d_norm);
-  const double product_err = 6 * gamma(5) * d_inf1 * d_inf1 * d_inf1;
-  const double sum_err = gamma(t.max_terms + 2) * d_norm1 * d_norm1 * d_norm1;
-  return 1.1 * (input_err + product_err + sum_err);
+  const double d2 = d_norm1 * d_norm1;
+  const double e_pair = 1.01 * std::sqrt(3.0) * (gamma(2) + gamma(t.pair_terms + 3)) * d2;
+  const double dot_size = d_norm1 * (d2 + e_pair);
+  const double rounding = d_norm1 * e_pair + (gamma(3) + 1.01 * gamma(t.dot_terms + 3)) * dot_size;
+  return 1.1 * (input_err + rounding);
 }
 
 // One longest-edge bisection step of a subdomain: coefficients of the two
