@@ -73,6 +73,12 @@ void Repairer::curve_interior(TetId t) {
   for (const auto& e : mesh::kTetEdges) {
     const VertId a = tv[e[0]], b = tv[e[1]];
     if (m_.high_order.has_edge(a, b)) continue;  // boundary (or done)
+    // det J at a corner depends only on the nodes of the three edges there:
+    // where the tet is invalid at a corner, no other edge can change that.
+    if (const ElementCheck c = check(tv); c.verdict != quality::Validity::kValid && c.where.dim == 0) {
+      const VertId corner = tv[c.where.index];
+      if (a != corner && b != corner) continue;
+    }
     const mesh::Shell shell = mesh::collect_shell(m_, a, b, t);
     const Outcome before = evaluate_tets(shell.tets);
     if (before.bad == 0) continue;
