@@ -348,19 +348,17 @@ std::vector<GatherEntity> make_gather_plan(int p, const std::vector<std::array<i
   return plan;
 }
 
-const std::vector<GatherEntity>& tet_gather_plan(int p) {
+// The plan of order p for a tet (K = 4) or a triangle (K = 3).
+template <std::size_t K>
+const std::vector<GatherEntity>& gather_plan(int p) {
   static const std::array<std::vector<GatherEntity>, kMaxOrder + 1> cache = [] {
     std::array<std::vector<GatherEntity>, kMaxOrder + 1> c;
-    for (int q = 1; q <= kMaxOrder; ++q) c[static_cast<std::size_t>(q)] = make_gather_plan<4>(q, cached_tet_indices(q));
-    return c;
-  }();
-  return cache[static_cast<std::size_t>(p)];
-}
-
-const std::vector<GatherEntity>& tri_gather_plan(int p) {
-  static const std::array<std::vector<GatherEntity>, kMaxOrder + 1> cache = [] {
-    std::array<std::vector<GatherEntity>, kMaxOrder + 1> c;
-    for (int q = 1; q <= kMaxOrder; ++q) c[static_cast<std::size_t>(q)] = make_gather_plan<3>(q, cached_tri_indices(q));
+    for (int q = 1; q <= kMaxOrder; ++q) {
+      if constexpr (K == 4)
+        c[static_cast<std::size_t>(q)] = make_gather_plan<4>(q, cached_tet_indices(q));
+      else
+        c[static_cast<std::size_t>(q)] = make_gather_plan<3>(q, cached_tri_indices(q));
+    }
     return c;
   }();
   return cache[static_cast<std::size_t>(p)];
@@ -368,7 +366,7 @@ const std::vector<GatherEntity>& tri_gather_plan(int p) {
 
 // Shared by tets and triangles: fills nodes from vertex ids and multi-indices.
 template <std::size_t K>
-void gather_nodes(const TetMesh& m, const std::array<VertId, K>& v, const std::vector<std::array<int, K>>& indices,
+bool gather_nodes(const TetMesh& m, const std::array<VertId, K>& v, const std::vector<std::array<int, K>>& indices,
                   const std::vector<GatherEntity>& plan, std::span<Vec3> out) {
   CM_ASSERT_OP(out.size(), ==, indices.size());
   const int p = m.high_order.order();
@@ -399,6 +397,7 @@ void gather_nodes(const TetMesh& m, const std::array<VertId, K>& v, const std::v
       }
     out[n] = nonzero == 1 ? m.coords[v[last]] : linear;
   }
+  return stored != 0;
 }
 
 template <std::size_t K>
@@ -452,15 +451,15 @@ std::vector<Vec3> gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>
   return out;
 }
 
-void gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts, std::span<Vec3> out) {
+bool gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts, std::span<Vec3> out) {
   const int p = m.high_order.order();
-  gather_nodes<4>(m, verts, cached_tet_indices(p), tet_gather_plan(p), out);
+  return gather_nodes<4>(m, verts, cached_tet_indices(p), gather_plan<4>(p), out);
 }
 
 std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri) {
   const int p = m.high_order.order();
   std::vector<Vec3> out(cached_tri_indices(p).size());
-  gather_nodes<3>(m, tri, cached_tri_indices(p), tri_gather_plan(p), out);
+  gather_nodes<3>(m, tri, cached_tri_indices(p), gather_plan<3>(p), out);
   return out;
 }
 

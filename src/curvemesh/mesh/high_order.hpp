@@ -108,8 +108,9 @@ std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t);
 /// tet an operator would create).
 std::vector<Vec3> gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts);
 /// The same into out, whose size must be the order's node count (no
-/// allocation: what the checks of a curved mesh call per tet).
-void gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts, std::span<Vec3> out);
+/// allocation: what the checks of a curved mesh call per tet). Returns
+/// whether any node came from storage (false: the tet is straight-sided).
+bool gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts, std::span<Vec3> out);
 /// All nodes of triangle (a,b,c) in the order of tri_node_indices(order).
 std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri);
 

@@ -42,18 +42,14 @@ struct OrderTables {
   std::vector<int> base;
   // det J = D1 . (D2 x D3) in two products of Bernstein expansions (see
   // compute_coefficients). First the cross products, of degree 2(p-1):
-  // pair_sum[s] += pair_weight * (D2[g] x D3[d]) for each entry of `pairs`.
-  struct PairTerm {
-    int g, d, s;
+  // pair_sum[target] += weight * (D2[first] x D3[second]) over `pairs`;
+  // then the dots: coefficient target += weight * D1[first] . pair_sum[second].
+  struct ProductTerm {
+    int first, second, target;
     double weight;
   };
-  struct DotTerm {
-    int b, s, target;
-    double weight;
-  };
-  std::vector<PairTerm> pairs;
-  // Then the dots: coefficient target += weight * D1[b] . pair_sum[s].
-  std::vector<DotTerm> dots;
+  std::vector<ProductTerm> pairs;
+  std::vector<ProductTerm> dots;
   int num_pair_sums = 0;  // Bernstein basis of degree 2(p-1)
   int pair_terms = 0;     // most cross products summed into one pair sum
   int dot_terms = 0;      // most dots summed into one coefficient
@@ -69,6 +65,29 @@ struct DegreeTables {
   std::array<std::vector<int>, 6> line_ranks;
   std::array<std::vector<int>, 6> line_lengths;
 };
+
+// The product of two Bernstein bases, B_a B_c = M(a) M(c) / M(a+c) B_{a+c}
+// (M = multinomial), every pair of ranks (a, c) with the rank of a + c. For
+// each a + c the weights sum to one (Vandermonde), so summing the products
+// into the target is a convex combination; most_terms gets the largest
+// number of pairs with one target.
+std::vector<OrderTables::ProductTerm> product_expansion(const std::vector<MultiIndex>& first,
+                                                        const std::vector<MultiIndex>& second, int& most_terms) {
+  std::vector<OrderTables::ProductTerm> terms;
+  std::vector<int> count;
+  for (std::size_t a = 0; a < first.size(); ++a)
+    for (std::size_t c = 0; c < second.size(); ++c) {
+      MultiIndex sum;
+      for (int k = 0; k < 4; ++k) sum[k] = first[a][k] + second[c][k];
+      const int target = bernstein_rank(sum);
+      terms.push_back({static_cast<int>(a), static_cast<int>(c), target,
+                       multinomial(first[a]) * multinomial(second[c]) / multinomial(sum)});
+      if (count.size() <= static_cast<std::size_t>(target)) count.resize(static_cast<std::size_t>(target) + 1, 0);
+      ++count[static_cast<std::size_t>(target)];
+    }
+  most_terms = *std::max_element(count.begin(), count.end());
+  return terms;
+}
 
 OrderTables build_order_tables(int p) {
   OrderTables t;
@@ -116,33 +135,9 @@ OrderTables build_order_tables(int p) {
     }
   }
 
-  // B_g B_d = M(g) M(d) / M(g+d) B_{g+d} (M = multinomial): for each degree
-  // the weights of a product expansion sum to one (Vandermonde), so every
-  // sum below is a convex combination.
   t.num_pair_sums = simplex_count(2 * (p - 1));
-  std::vector<int> pair_count(static_cast<std::size_t>(t.num_pair_sums), 0);
-  std::vector<int> dot_count(static_cast<std::size_t>(t.num_coefs), 0);
-  for (std::size_t g = 0; g < derivs.size(); ++g)
-    for (std::size_t d = 0; d < derivs.size(); ++d) {
-      MultiIndex sum;
-      for (int k = 0; k < 4; ++k) sum[k] = derivs[g][k] + derivs[d][k];
-      const int s = bernstein_rank(sum);
-      t.pairs.push_back({static_cast<int>(g), static_cast<int>(d), s,
-                         multinomial(derivs[g]) * multinomial(derivs[d]) / multinomial(sum)});
-      ++pair_count[static_cast<std::size_t>(s)];
-    }
-  const auto pair_indices = bernstein_indices(2 * (p - 1));
-  for (std::size_t b = 0; b < derivs.size(); ++b)
-    for (std::size_t s = 0; s < pair_indices.size(); ++s) {
-      MultiIndex sum;
-      for (int k = 0; k < 4; ++k) sum[k] = derivs[b][k] + pair_indices[s][k];
-      const int rank = bernstein_rank(sum);
-      t.dots.push_back({static_cast<int>(b), static_cast<int>(s), rank,
-                        multinomial(derivs[b]) * multinomial(pair_indices[s]) / multinomial(sum)});
-      ++dot_count[static_cast<std::size_t>(rank)];
-    }
-  t.pair_terms = *std::max_element(pair_count.begin(), pair_count.end());
-  t.dot_terms = *std::max_element(dot_count.begin(), dot_count.end());
+  t.pairs = product_expansion(derivs, derivs, t.pair_terms);
+  t.dots = product_expansion(derivs, bernstein_indices(2 * (p - 1)), t.dot_terms);
   return t;
 }
 
@@ -249,7 +244,8 @@ double compute_coefficients(const OrderTables& t, std::span<const Vec3> nodes, d
   std::array<Vec3, kMaxPairSums> pair_sum;
   std::fill(pair_sum.begin(), pair_sum.begin() + t.num_pair_sums, Vec3::Zero());
   for (const auto& [g, d, s, w] : t.pairs)
-    pair_sum[static_cast<std::size_t>(s)] += w * deriv[1][static_cast<std::size_t>(g)].cross(deriv[2][static_cast<std::size_t>(d)]);
+    pair_sum[static_cast<std::size_t>(s)] +=
+        w * deriv[1][static_cast<std::size_t>(g)].cross(deriv[2][static_cast<std::size_t>(d)]);
   std::fill(coefs, coefs + t.num_coefs, 0.0);
   for (const auto& [b, s, target, w] : t.dots)
     coefs[target] += w * deriv[0][static_cast<std::size_t>(b)].dot(pair_sum[static_cast<std::size_t>(s)]);

@@ -115,7 +115,10 @@ ShapeMeasure shape_measure_from_bezier(int order, std::span<const double> jacobi
   constexpr auto kN = static_cast<std::size_t>(points_for_degree(kMaxJacobianDegree));
   constexpr std::size_t kQ = kMaxJacobianDegree + 1;
   // Stage 1, along a: f1[(a3, a2)][i].
-  std::array<double, kQ * (kQ + 1) / 2 * kN> f1{};
+  // Only the parts this order uses are cleared: the arrays fit order 4.
+  const auto num_pairs = static_cast<std::size_t>((q + 1) * (q + 2) / 2);
+  std::array<double, kQ * (kQ + 1) / 2 * kN> f1;
+  std::fill_n(f1.begin(), num_pairs * n, 0.0);
   const int* rank = table.ranks.data();
   std::size_t pair = 0;
   for (int a3 = 0; a3 <= q; ++a3)
@@ -129,7 +132,8 @@ ShapeMeasure shape_measure_from_bezier(int order, std::span<const double> jacobi
       }
     }
   // Stage 2, along b: f2[a3][j][i].
-  std::array<double, kQ * kN * kN> f2{};
+  std::array<double, kQ * kN * kN> f2;
+  std::fill_n(f2.begin(), static_cast<std::size_t>(q + 1) * n * n, 0.0);
   pair = 0;
   for (int a3 = 0; a3 <= q; ++a3) {
     const int r2 = q - a3;
@@ -142,7 +146,8 @@ ShapeMeasure shape_measure_from_bezier(int order, std::span<const double> jacobi
     }
   }
   // Stage 3, along c: det J at point (i, j, k), stored [k][j][i].
-  std::array<double, kN * kN * kN> det{};
+  std::array<double, kN * kN * kN> det;
+  std::fill_n(det.begin(), n * n * n, 0.0);
   for (int a3 = 0; a3 <= q; ++a3) {
     const double* in = &f2[static_cast<std::size_t>(a3) * n * n];
     const double* basis = &bc[tri_index(q, a3) * n];

@@ -173,7 +173,8 @@ class Repairer {
   ElementCheck check(const Verts& v) const {
     std::array<Vec3, mesh::kMaxTetNodes> buffer;
     const std::span<Vec3> nodes(buffer.data(), nodes_per_tet_);
-    mesh::gather_tet_nodes(m_, v, nodes);
+    // A straight-sided tet is one orient3d: cheaper than the memo's lookup.
+    if (!mesh::gather_tet_nodes(m_, v, nodes)) return check_element(order_, nodes, o_.acceptance);
     return memo_(nodes);
   }
   Outcome evaluate(std::span<const Verts> tets) const {
