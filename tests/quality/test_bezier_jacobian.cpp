@@ -435,6 +435,42 @@ long double corner_det_exact(int p, const std::vector<Vec3>& nodes) {
          t[0][2] * (t[1][0] * t[2][1] - t[1][1] * t[2][0]);
 }
 
+TEST(BezierJacobian, RefiningBelowABoundInOnePassEqualsCertifyingTwice) {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int refined = 0, left = 0;
+  for (int p = 2; p <= 3; ++p)
+    for (int trial = 0; trial < 400; ++trial) {
+      auto nodes = linear_nodes(p, random_good_tet(rng));
+      const double amplitude = 0.02 * (trial % 25);
+      for (std::size_t n = 4; n < nodes.size(); ++n) nodes[n] += amplitude * Vec3(u(rng), u(rng), u(rng));
+      ValidityOptions one;
+      one.bound_tolerance = 0.01;
+      one.refine_below = 0.5;
+      const ValidityReport a = certify_jacobian(p, nodes, one);
+      // The two calls it stands for.
+      ValidityReport b = certify_jacobian(p, nodes);
+      const bool refine = b.verdict == Validity::kValid && b.scaled_jacobian_lower < one.refine_below;
+      if (refine) {
+        ValidityOptions tight;
+        tight.bound_tolerance = one.bound_tolerance;
+        b = certify_jacobian(p, nodes, tight);
+      }
+      refined += refine;
+      left += b.verdict == Validity::kValid && !refine;
+      EXPECT_EQ(a.verdict, b.verdict) << p << " " << trial;
+      EXPECT_EQ(a.min_lower, b.min_lower) << p << " " << trial;
+      EXPECT_EQ(a.max_upper, b.max_upper) << p << " " << trial;
+      EXPECT_EQ(a.min_upper, b.min_upper) << p << " " << trial;
+      EXPECT_EQ(a.scaled_jacobian_lower, b.scaled_jacobian_lower) << p << " " << trial;
+      EXPECT_EQ(a.splits, b.splits) << p << " " << trial;
+      EXPECT_EQ(a.where_entity, b.where_entity) << p << " " << trial;
+    }
+  // Both branches were taken.
+  EXPECT_GT(refined, 20);
+  EXPECT_GT(left, 20);
+}
+
 TEST(BezierJacobian, RoundingBoundHoldsFarFromTheOrigin) {
   // Coordinates up to 1e6 on elements of size 1e-2..1: the rounding of the
   // nodes themselves, then of the coefficients, against the stated bound.

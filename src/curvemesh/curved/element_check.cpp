@@ -61,16 +61,13 @@ ElementCheck check_element(int order, std::span<const Vec3> nodes, const Accepta
   }
   std::array<double, quality::simplex_count(quality::kMaxJacobianDegree)> coefs;
   const std::span<double> jacobian(coefs.data(), std::size_t(quality::simplex_count(3 * (order - 1))));
-  quality::ValidityOptions first;
-  if (!locate_minimum) first.locate_splits = 0;
-  quality::ValidityReport r = quality::certify_jacobian(order, nodes, first, jacobian);
   // The first certified bound can be loose; where it decides whether the
-  // element is acceptable, refine until it is within 1% of the minimum.
-  if (r.verdict == quality::Validity::kValid && r.scaled_jacobian_lower < 2 * acceptance.min_scaled_jacobian) {
-    quality::ValidityOptions tight;
-    tight.bound_tolerance = 0.01;
-    r = quality::certify_jacobian(order, nodes, tight);
-  }
+  // element is acceptable, it is refined until within 1% of the minimum.
+  quality::ValidityOptions options;
+  if (!locate_minimum) options.locate_splits = 0;
+  options.bound_tolerance = 0.01;
+  options.refine_below = 2 * acceptance.min_scaled_jacobian;
+  const quality::ValidityReport r = quality::certify_jacobian(order, nodes, options, jacobian);
   c.verdict = r.verdict;
   c.scaled_jacobian = r.verdict == quality::Validity::kValid ? r.scaled_jacobian_lower
                                                              : std::min(0.0, r.scaled_jacobian_lower);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/core/predicates.hpp"
@@ -534,30 +535,41 @@ ValidityReport certify_jacobian(int order, std::span<const Vec3> nodes,
   rep.rounding_bound = err;
   rep.min_upper = std::numeric_limits<double>::infinity();
   rep.max_lower = -std::numeric_limits<double>::infinity();
-  Search search(dt, err, options, rep);
+  // With refine_below, first decide validity only; the tolerance then
+  // continues the same best-first subdivision, which is the sequence of
+  // splits a run with the tolerance from the start makes.
+  const bool two_phase = options.refine_below > 0 && options.bound_tolerance > 0;
+  ValidityOptions phase = options;
+  if (two_phase) phase.bound_tolerance = 0;
+  Search search(dt, err, phase, rep);
   const std::array<Bary, 4> unit{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
   for (std::size_t k = 0; k < 4; ++k)
     search.note_value(root[static_cast<std::size_t>(dt.corner[k])], unit[k]);
 
   const double gap_scale = magnitude;
-  const bool settled = lo > err && (options.bound_tolerance <= 0 ||
-                                    rep.min_upper - lo <= options.bound_tolerance * gap_scale);
-  if (settled) {
-    // The common case for a good element: no subdivision, no allocation.
-    rep.verdict = Validity::kValid;
-    rep.min_lower = lo;
-    rep.max_upper = hi;
-  } else {
-    search.push(root.data(), unit, 0);
+  const auto settled = [&](double tolerance) {
+    return lo > err && (tolerance <= 0 || rep.min_upper - lo <= tolerance * gap_scale);
+  };
+  // The common case for a good element: no subdivision, no allocation.
+  double lower = lo, upper = hi;
+  bool searched = false;
+  const auto search_on = [&] {
+    if (!searched) search.push(root.data(), unit, 0);
+    searched = true;
     search.run(gap_scale);
-    const auto [lower, upper] = search.bounds();
-    rep.min_lower = lower;
-    rep.max_upper = upper;
-    if (search.invalid())
-      rep.verdict = Validity::kInvalid;
-    else
-      rep.verdict = lower > err ? Validity::kValid : Validity::kUndetermined;
+    std::tie(lower, upper) = search.bounds();
+  };
+  if (!settled(phase.bound_tolerance)) search_on();
+  if (two_phase && !search.invalid() && lower > err && lower / upper < options.refine_below) {
+    phase.bound_tolerance = options.bound_tolerance;
+    if (searched || !settled(phase.bound_tolerance)) search_on();
   }
+  rep.min_lower = lower;
+  rep.max_upper = upper;
+  if (search.invalid())
+    rep.verdict = Validity::kInvalid;
+  else
+    rep.verdict = lower > err ? Validity::kValid : Validity::kUndetermined;
   rep.where_entity = classify_bary(rep.where, 0);
   rep.scaled_jacobian_lower = scaled_lower(rep);
   return rep;

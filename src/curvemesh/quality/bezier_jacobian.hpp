@@ -64,6 +64,12 @@ struct ValidityOptions {
   /// refining until min_upper - min_lower <= bound_tolerance * max |coef|,
   /// i.e. until the certified lower bound is that close to the true minimum.
   double bound_tolerance = 0;
+  /// > 0 (with bound_tolerance > 0): the tolerance applies only to an
+  /// element certified valid whose scaled bound min_lower / max_upper comes
+  /// out below this once validity is decided; the others stop there. The
+  /// same report as deciding validity first and certifying again with the
+  /// tolerance where the bound is low, in one pass.
+  double refine_below = 0;
   /// After invalidity is found, further bisections (best first) spent to move
   /// `where` toward the minimum of det J; 0 reports the first point found.
   int locate_splits = 24;
