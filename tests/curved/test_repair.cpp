@@ -90,6 +90,37 @@ TEST(ElementCheck, MemoAnswersOnlyForTheSameNodes) {
   EXPECT_TRUE(straight.acceptable);
 }
 
+// The cache's table grows past many entries and still finds each one by
+// its exact nodes, and nothing else.
+TEST(ElementCheck, CacheFindsEveryEntryAfterGrowing) {
+  curved::CheckCache cache(2);
+  std::vector<std::vector<Vec3>> stored;
+  for (int k = 0; k < 3000; ++k) {
+    auto n = straight_p2(kUnit);
+    n[4] = Vec3(0.5, 1e-3 * k, 0);
+    curved::ElementCheck c;
+    c.scaled_jacobian = k;
+    cache.add(n, c);
+    stored.push_back(n);
+  }
+  EXPECT_EQ(cache.size(), 3000u);
+  for (int k = 0; k < 3000; ++k) {
+    const curved::ElementCheck* c = cache.find(stored[static_cast<std::size_t>(k)]);
+    ASSERT_NE(c, nullptr) << k;
+    EXPECT_EQ(c->scaled_jacobian, k);
+    auto other = stored[static_cast<std::size_t>(k)];
+    other[5].z() = std::nextafter(other[5].z(), 1.0);
+    EXPECT_EQ(cache.find(other), nullptr) << k;
+  }
+  // A repeated node list keeps its first result.
+  curved::ElementCheck later;
+  later.scaled_jacobian = -1;
+  cache.add(stored[7], later);
+  EXPECT_EQ(cache.find(stored[7])->scaled_jacobian, 7);
+  cache.clear();
+  EXPECT_EQ(cache.find(stored[7]), nullptr);
+}
+
 // check_mesh again with the first one's cache gives what a fresh check
 // gives, after a node moved too.
 TEST(ElementCheck, RecheckWithTheCacheEqualsAFreshCheck) {

@@ -105,18 +105,41 @@ std::uint64_t hash_nodes(std::span<const Vec3> nodes) {
 CheckCache::CheckCache(int order) : order_(order), per_tet_(nodes_per_tet(order)) {}
 
 const ElementCheck* CheckCache::find(std::span<const Vec3> tet_nodes) const {
-  if (tet_nodes.size() != per_tet_) return nullptr;
-  const auto it = by_hash_.find(hash_nodes(tet_nodes));
-  if (it == by_hash_.end()) return nullptr;
-  const Vec3* stored = &nodes_[std::size_t(it->second) * per_tet_];
-  return std::equal(tet_nodes.begin(), tet_nodes.end(), stored) ? &checks_[it->second] : nullptr;
+  if (tet_nodes.size() != per_tet_ || by_hash_.empty()) return nullptr;
+  const std::uint64_t hash = hash_nodes(tet_nodes);
+  const std::size_t mask = by_hash_.size() - 1;
+  for (std::size_t i = hash & mask;; i = (i + 1) & mask) {
+    const Slot& slot = by_hash_[i];
+    if (slot.entry == kNoEntry) return nullptr;
+    if (slot.hash != hash) continue;
+    const Vec3* stored = &nodes_[std::size_t(slot.entry) * per_tet_];
+    return std::equal(tet_nodes.begin(), tet_nodes.end(), stored) ? &checks_[slot.entry] : nullptr;
+  }
+}
+
+void CheckCache::insert(std::uint64_t hash, std::uint32_t entry) {
+  if (2 * (checks_.size() + 1) > by_hash_.size()) {
+    // Grown, then every entry so far indexed again (entry is the newest).
+    by_hash_.assign(std::max<std::size_t>(64, std::bit_ceil(4 * (checks_.size() + 1))), Slot{});
+    for (std::uint32_t k = 0; k < entry; ++k)
+      insert(hash_nodes(std::span<const Vec3>(&nodes_[std::size_t(k) * per_tet_], per_tet_)), k);
+  }
+  const std::size_t mask = by_hash_.size() - 1;
+  for (std::size_t i = hash & mask;; i = (i + 1) & mask) {
+    Slot& slot = by_hash_[i];
+    if (slot.entry == kNoEntry) {
+      slot = {hash, entry};
+      return;
+    }
+    if (slot.hash == hash) return;  // the first entry with a hash stays
+  }
 }
 
 void CheckCache::add(std::span<const Vec3> tet_nodes, const ElementCheck& c) {
   if (tet_nodes.size() != per_tet_) return;
-  by_hash_.emplace(hash_nodes(tet_nodes), static_cast<std::uint32_t>(checks_.size()));
   nodes_.insert(nodes_.end(), tet_nodes.begin(), tet_nodes.end());
   checks_.push_back(c);
+  insert(hash_nodes(tet_nodes), static_cast<std::uint32_t>(checks_.size() - 1));
 }
 
 void CheckCache::clear() {
@@ -126,10 +149,9 @@ void CheckCache::clear() {
 }
 
 void CheckCache::index_all() {
-  by_hash_.clear();
-  by_hash_.reserve(checks_.size());
+  by_hash_.assign(std::max<std::size_t>(64, std::bit_ceil(2 * checks_.size() + 1)), Slot{});
   for (std::uint32_t k = 0; k < checks_.size(); ++k)
-    by_hash_.emplace(hash_nodes(std::span<const Vec3>(&nodes_[std::size_t(k) * per_tet_], per_tet_)), k);
+    insert(hash_nodes(std::span<const Vec3>(&nodes_[std::size_t(k) * per_tet_], per_tet_)), k);
 }
 
 namespace {

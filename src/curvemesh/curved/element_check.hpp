@@ -20,7 +20,6 @@
 // shared torus acceptable (I = 0.52 for one whose det J changes sign).
 #include <cstdint>
 #include <span>
-#include <unordered_map>
 #include <vector>
 
 #include "curvemesh/mesh/tet_mesh.hpp"
@@ -108,7 +107,16 @@ class CheckCache {
   std::size_t per_tet_ = 0;
   std::vector<Vec3> nodes_;  // per_tet_ per entry
   std::vector<ElementCheck> checks_;
-  std::unordered_map<std::uint64_t, std::uint32_t> by_hash_;  // first entry with that hash
+  // Open addressing on the node hash, the first entry with each hash (size
+  // a power of two, at most half full): rebuilt for every tet of a mesh
+  // check, looked up for every tet of the next one.
+  static constexpr std::uint32_t kNoEntry = 0xffffffffu;
+  struct Slot {
+    std::uint64_t hash = 0;
+    std::uint32_t entry = kNoEntry;
+  };
+  void insert(std::uint64_t hash, std::uint32_t entry);
+  std::vector<Slot> by_hash_;
 };
 
 /// With `exact_measures` false the measure statistics are lower bounds
