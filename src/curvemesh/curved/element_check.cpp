@@ -85,10 +85,6 @@ ElementCheck check_element(int order, std::span<const Vec3> nodes, const Accepta
 
 namespace {
 
-std::size_t nodes_per_tet(int order) {
-  return order >= 1 ? std::size_t((order + 1) * (order + 2) * (order + 3) / 6) : 4;
-}
-
 std::uint64_t hash_nodes(std::span<const Vec3> nodes) {
   std::uint64_t h = 0xcbf29ce484222325ull;
   for (const Vec3& p : nodes)
@@ -102,7 +98,7 @@ std::uint64_t hash_nodes(std::span<const Vec3> nodes) {
 
 }  // namespace
 
-CheckCache::CheckCache(int order) : order_(order), per_tet_(nodes_per_tet(order)) {}
+CheckCache::CheckCache(int order) : order_(order), per_tet_(mesh::tet_node_count(order)) {}
 
 const ElementCheck* CheckCache::find(std::span<const Vec3> tet_nodes) const {
   if (tet_nodes.size() != per_tet_ || by_hash_.empty()) return nullptr;
@@ -176,17 +172,14 @@ ElementCheck check_straight(const mesh::TetMesh& m, TetId t, const Acceptance& a
 
 ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& acceptance, bool exact_measure) {
   if (plainly_straight(m, t)) return check_straight(m, t, acceptance);
-  std::array<Vec3, mesh::kMaxTetNodes> buffer;
-  const std::span<Vec3> nodes(buffer.data(), nodes_per_tet(m.high_order.order()));
-  mesh::gather_tet_nodes(m, m.tet2verts[t], nodes);
-  return check_element(m.high_order.order(), nodes, acceptance, exact_measure);
+  return check_element(m.high_order.order(), mesh::tet_nodes(m, m.tet2verts[t]).view(), acceptance, exact_measure);
 }
 
 MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures,
                      const CheckCache* reuse, CheckCache* keep) {
   const std::size_t nt = m.num_tets();
   const int order = m.high_order.order();
-  const std::size_t per_tet = nodes_per_tet(order);
+  const std::size_t per_tet = mesh::tet_node_count(order);
   if (reuse && reuse->order() != order) reuse = nullptr;
   // Curved tets get consecutive entries in `keep`, in tet order.
   std::vector<std::uint32_t> entry(nt + 1, 0);
@@ -208,9 +201,8 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
         checks[t] = check_straight(m, tet, acceptance);
         continue;
       }
-      std::array<Vec3, mesh::kMaxTetNodes> buffer;
-      const std::span<Vec3> nodes(buffer.data(), per_tet);
-      mesh::gather_tet_nodes(m, m.tet2verts[tet], nodes);
+      const mesh::TetNodes gathered = mesh::tet_nodes(m, m.tet2verts[tet]);
+      const std::span<const Vec3> nodes = gathered.view();
       const ElementCheck* known = reuse ? reuse->find(nodes) : nullptr;
       if (known && (known->measure_exact || !exact_measures))
         checks[t] = *known;

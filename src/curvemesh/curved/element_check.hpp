@@ -56,8 +56,9 @@ struct ElementCheck {
 /// when acceptability needs it, an I. For a valid element I >= min det J /
 /// max det J >= the certified scaled Jacobian bound, so where that bound
 /// already clears min_measure, I cannot decide anything: unless asked for,
-/// it is then not computed (measure = the bound, measure_exact = false),
-/// which halves the cost of checking a curved order-3 tet.
+/// it is then not computed (measure = the bound, measure_exact = false):
+/// det J is not evaluated at the rule's points. When it is, it comes from
+/// the coefficients the certification computed (shape_measure_from_bezier).
 /// For an element that is not valid, `locate_minimum` spends further
 /// subdivisions moving `where` toward the least det J (and tightening the
 /// negative bound); without it `where` is the first point found with

@@ -208,10 +208,7 @@ RepairStats Repairer::run(std::span<const TetId> unacceptable) {
       if (c.acceptable) continue;
       if (st_.passes == 0) {
         // Where det J is least: what the report names as the problem.
-        std::array<Vec3, mesh::kMaxTetNodes> buffer;
-        const std::span<Vec3> nodes(buffer.data(), nodes_per_tet_);
-        mesh::gather_tet_nodes(m_, m_.tet2verts[t], nodes);
-        note_problem(t, check_element(order_, nodes, o_.acceptance));
+        note_problem(t, check_element(order_, mesh::tet_nodes(m_, m_.tet2verts[t]).view(), o_.acceptance));
       }
       if (unchanged_since_failure(t)) continue;
       if (retriangulate(t) || delete_element(t) || remesh(t) || reposition(t)) {

@@ -446,14 +446,17 @@ void scatter_nodes(TetMesh& m, const std::array<VertId, K>& v,
 std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t) { return gather_tet_nodes(m, m.tet2verts[t]); }
 
 std::vector<Vec3> gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts) {
-  std::vector<Vec3> out(cached_tet_indices(m.high_order.order()).size());
-  gather_tet_nodes(m, verts, out);
-  return out;
+  const TetNodes n = tet_nodes(m, verts);
+  return {n.view().begin(), n.view().end()};
 }
 
-bool gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts, std::span<Vec3> out) {
+TetNodes tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts) {
   const int p = m.high_order.order();
-  return gather_nodes<4>(m, verts, cached_tet_indices(p), gather_plan<4>(p), out);
+  TetNodes out;
+  out.count = cached_tet_indices(p).size();
+  out.stored = gather_nodes<4>(m, verts, cached_tet_indices(p), gather_plan<4>(p),
+                               std::span<Vec3>(out.buffer.data(), out.count));
+  return out;
 }
 
 std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri) {

@@ -13,8 +13,10 @@
 namespace cm::mesh {
 
 inline constexpr int kMaxOrder = 3;
-/// Nodes of an order-kMaxOrder tet: a buffer that fits any tet.
-inline constexpr std::size_t kMaxTetNodes = std::size_t((kMaxOrder + 1) * (kMaxOrder + 2) * (kMaxOrder + 3) / 6);
+
+/// Nodes of an order-p tet, (p+1)(p+2)(p+3)/6 (the 4 vertices for p < 1).
+constexpr std::size_t tet_node_count(int p) { return p >= 1 ? std::size_t((p + 1) * (p + 2) * (p + 3) / 6) : 4; }
+inline constexpr std::size_t kMaxTetNodes = tet_node_count(kMaxOrder);
 
 /// Barycentric multi-indices (i0,i1,i2,i3), i0+..+i3 = p, of the nodes of an
 /// order-p Lagrange tet in curvemesh's internal order: the 4 vertices; then for
@@ -107,10 +109,16 @@ std::vector<Vec3> gather_tet_nodes(const TetMesh& m, TetId t);
 /// The same for a tet given by its vertices (it need not be in the mesh: a
 /// tet an operator would create).
 std::vector<Vec3> gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts);
-/// The same into out, whose size must be the order's node count (no
-/// allocation: what the checks of a curved mesh call per tet). Returns
-/// whether any node came from storage (false: the tet is straight-sided).
-bool gather_tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts, std::span<Vec3> out);
+/// A tet's nodes in a buffer that fits any order: what the checks of a
+/// curved mesh gather per tet, without an allocation.
+struct TetNodes {
+  std::array<Vec3, kMaxTetNodes> buffer;
+  std::size_t count = 0;
+  bool stored = false;  ///< whether any node came from storage (false: straight-sided)
+  std::span<const Vec3> view() const { return {buffer.data(), count}; }
+};
+/// The nodes of the tet with these vertices, as gather_tet_nodes gives them.
+TetNodes tet_nodes(const TetMesh& m, const std::array<VertId, 4>& verts);
 /// All nodes of triangle (a,b,c) in the order of tri_node_indices(order).
 std::vector<Vec3> gather_tri_nodes(const TetMesh& m, const std::array<VertId, 3>& tri);
 

@@ -52,6 +52,7 @@ TetRule build_tet_rule(int n) {
   const GaussRule rc = gauss_jacobi(n, 2);
   TetRule rule;
   rule.exact_degree = 2 * n - 1;
+  rule.axis_nodes = {ra.nodes, rb.nodes, rc.nodes};
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j)
       for (int k = 0; k < n; ++k) {

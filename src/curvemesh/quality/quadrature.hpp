@@ -1,6 +1,7 @@
 #pragma once
 // Gauss-Jacobi rules and the collapsed (conical, Duffy) product rule on the
 // reference tetrahedron, with positive weights and interior points.
+#include <array>
 #include <vector>
 
 #include "curvemesh/quality/bernstein.hpp"
@@ -25,6 +26,10 @@ struct TetRule {
   std::vector<Bary> points;
   std::vector<double> weights;
   int exact_degree = 0;  ///< 2n - 1
+  /// The 1D nodes in the collapsed coordinates (a, b, c), where
+  /// xi3 = c, xi2 = b (1-c), xi1 = a (1-b)(1-c); point (i, j, k) of the
+  /// product is points[(i n + j) n + k].
+  std::array<std::vector<double>, 3> axis_nodes;
 };
 
 inline constexpr int kMaxRulePoints = 10;  ///< largest n of collapsed_tet_rule

@@ -66,16 +66,16 @@ const FactorTable& factor_table(int order) {
     const int n = points_for_degree(q);
     table.degree = q;
     table.n = n;
-    // The same nodes as collapsed_tet_rule(n) (see quadrature.cpp).
+    const TetRule& rule = collapsed_tet_rule(n);
     for (int dir = 0; dir < 3; ++dir) {
-      const GaussRule rule = gauss_jacobi(n, dir);
+      const std::vector<double>& nodes = rule.axis_nodes[static_cast<std::size_t>(dir)];
       std::vector<double>& b = table.basis[static_cast<std::size_t>(dir)];
       b.assign(tri_index(q + 1, 0) * static_cast<std::size_t>(n), 0);
       for (int r = 0; r <= q; ++r)
         for (int sdeg = 0; sdeg <= r; ++sdeg) {
           const double binomial = multinomial({r - sdeg, sdeg, 0, 0});
           for (int i = 0; i < n; ++i) {
-            const double t = rule.nodes[static_cast<std::size_t>(i)];
+            const double t = nodes[static_cast<std::size_t>(i)];
             b[tri_index(r, sdeg) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)] =
                 binomial * std::pow(1 - t, r - sdeg) * std::pow(t, sdeg);
           }

@@ -152,7 +152,6 @@ class Repairer {
         boundary_(m),
         placer_(m, model),
         order_(m.high_order.order()),
-        nodes_per_tet_(std::size_t((order_ + 1) * (order_ + 2) * (order_ + 3) / 6)),
         memo_(order_, o.acceptance) {
     modify::mark_boundary_faces(ed_);
     ed_.set_hook([this](const mesh::TetMesh&, std::span<const TetId> created) { after_edit(created); });
@@ -171,11 +170,10 @@ class Repairer {
 
  private:
   ElementCheck check(const Verts& v) const {
-    std::array<Vec3, mesh::kMaxTetNodes> buffer;
-    const std::span<Vec3> nodes(buffer.data(), nodes_per_tet_);
+    const mesh::TetNodes nodes = mesh::tet_nodes(m_, v);
     // A straight-sided tet is one orient3d: cheaper than the memo's lookup.
-    if (!mesh::gather_tet_nodes(m_, v, nodes)) return check_element(order_, nodes, o_.acceptance);
-    return memo_(nodes);
+    if (!nodes.stored) return check_element(order_, nodes.view(), o_.acceptance);
+    return memo_(nodes.view());
   }
   Outcome evaluate(std::span<const Verts> tets) const {
     Outcome out;
@@ -240,7 +238,6 @@ class Repairer {
   modify::Cavity cav_;
   NodePlacer placer_;
   int order_;
-  std::size_t nodes_per_tet_;
   mutable CheckMemo memo_;
   RepairStats st_;
   std::size_t budget_ = 0;
