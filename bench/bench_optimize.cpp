@@ -6,17 +6,18 @@
 //   gmsh -3 -nt 1 -setnumber Mesh.Optimize 0 -setnumber Mesh.MeshSizeFromCurvature 12
 //        -setnumber Mesh.MeshSizeMax H MODEL -o in.msh
 // or a mesh file given directly. Ours is `curvemesh optimize` without a
-// size map (improve_quality). Gmsh cannot optimize a mesh it reads (its
-// optimizer only runs on regions it meshed), so its side is the same command
-// with Mesh.Optimize 1 and Mesh.OptimizeNetgen 1: the same tetrahedra
+// size map (improve_quality). Gmsh's command line cannot optimize a mesh it
+// reads (its optimizer only runs on regions it meshed), so its side is the
+// same command with Mesh.Optimize 1 and Mesh.OptimizeNetgen 1: the same tetrahedra
 // (meshing is deterministic with one thread) and then its optimizers, whose
 // own time is read from its log ("Done optimizing mesh (Wall w, CPU c)").
 // Another row runs ours with the model (`curvemesh optimize --model`): the
 // Gmsh mesh classified on it (generate::classify_on_model, its time in the
 // JSON record), then boundary vertices moved on their model face or edge.
 // Gmsh is told the model's length unit so that its mesh and H are in it.
-// A last row per model runs ours on the input with its interior vertices
-// moved at random (kept positive) and some pushed almost flat.
+// A last pair of rows per model runs ours, and Gmsh's optimizer through its
+// Python API when python3-gmsh is installed, on the input with its interior
+// vertices moved at random (kept positive) and some pushed almost flat.
 // Times are CPU seconds of the optimization alone (the machine may be
 // shared; wall time follows in the JSON records).
 //
@@ -144,6 +145,50 @@ void perturb(cm::mesh::TetMesh& m, unsigned seed) {
     const cm::Vec3 here = m.coords[v];
     m.coords[v] = here - 0.999 * n * n.dot(here - f[0]);
     if (!positive()) m.coords[v] = here;
+  }
+}
+
+// Gmsh's optimizer on a mesh it reads, through its Python API (Debian's
+// python3-gmsh, for the system interpreter): gmsh.model.mesh.optimize with
+// force set runs on discrete volumes too, which the command line cannot (its
+// optimizer only runs after meshing). Netgen's optimizer follows when this
+// Gmsh has it (Debian's does not). Its log has the same "Done optimizing
+// mesh" lines. Returns the interpreter, or "" when none has the module.
+std::string gmsh_python() {
+  for (const char* python : {"/usr/bin/python3", "python3"})
+    if (run(fmt::format("{} -c 'import gmsh' > /dev/null 2>&1", python))) return python;
+  return {};
+}
+
+bool gmsh_optimize_mesh(const std::string& python, const fs::path& in, const fs::path& out, const fs::path& log) {
+  const fs::path script = out.parent_path() / "gmsh_optimize.py";
+  std::ofstream(script) << "import sys, gmsh\n"
+                           "gmsh.initialize()\n"
+                           "gmsh.option.setNumber('General.Terminal', 1)\n"
+                           "gmsh.option.setNumber('Mesh.MshFileVersion', 4.1)\n"
+                           "gmsh.open(sys.argv[1])\n"
+                           "gmsh.model.mesh.optimize('', force=True)\n"
+                           "try:\n"
+                           "    gmsh.model.mesh.optimize('Netgen', force=True)\n"
+                           "except Exception:\n"
+                           "    pass\n"
+                           "gmsh.write(sys.argv[2])\n"
+                           "gmsh.finalize()\n";
+  return run(fmt::format("{} '{}' '{}' '{}' > '{}' 2>&1", python, script.string(), in.string(), out.string(),
+                         log.string()));
+}
+
+// Reads what another optimizer wrote into r (its quality, what holds its
+// worst tets, validity).
+void read_result(const fs::path& out, Row& r) {
+  try {
+    const auto mm = cm::io::read_mesh(out.string());
+    r.after = cm::optimize::summarize_mesh(mm);
+    r.limit = cm::optimize::classify_boundary_limit(mm);
+    r.valid = cm::mesh::validate(mm, cm::mesh::Level::kTopology).valid();
+    r.ok = true;
+  } catch (const std::exception& e) {
+    r.note = fmt::format("cannot read its output: {}", e.what());
   }
 }
 
@@ -353,6 +398,8 @@ int main(int argc, char** argv) {
   const std::size_t worst_listed = std::getenv("CM_BENCH_WORST") ? std::stoul(std::getenv("CM_BENCH_WORST")) : 3;
   const bool have_gmsh = on_path("gmsh");
   const bool have_mmg = on_path("mmg3d_O3");
+  const std::string python = gmsh_python();
+  const bool have_gmsh_python = !python.empty();
   const fs::path tmp = fs::temp_directory_path() / fmt::format("curvemesh_bench_optimize_{}", getpid());
   fs::create_directories(tmp);
   // After the output's quality: the tets under 10 degrees the boundary pins
@@ -425,15 +472,7 @@ int main(int argc, char** argv) {
       run(gmsh_command(c, out, true));
       if (fs::exists(out) && fs::file_size(out) > 0) {
         gmsh_optimizer_times(fs::path(out.string() + ".log"), g.wall, g.cpu);
-        try {
-          const auto gm = cm::io::read_mesh(out.string());
-          g.after = cm::optimize::summarize_mesh(gm);
-          g.limit = cm::optimize::classify_boundary_limit(gm);
-          g.valid = cm::mesh::validate(gm, cm::mesh::Level::kTopology).valid();
-          g.ok = true;
-        } catch (const std::exception& e) {
-          g.note = fmt::format("cannot read its output: {}", e.what());
-        }
+        read_result(out, g);
       } else {
         g.note = "gmsh failed";
       }
@@ -452,15 +491,7 @@ int main(int argc, char** argv) {
       // (it includes mmg's reading and writing).
       r.wall = r.cpu = wall.seconds();
       if (done) {
-        try {
-          const auto mm = cm::io::read_mesh(out_mesh.string());
-          r.after = cm::optimize::summarize_mesh(mm);
-          r.limit = cm::optimize::classify_boundary_limit(mm);
-          r.valid = cm::mesh::validate(mm, cm::mesh::Level::kTopology).valid();
-          r.ok = true;
-        } catch (const std::exception& e) {
-          r.note = fmt::format("cannot read its output: {}", e.what());
-        }
+        read_result(out_mesh, r);
       } else {
         r.note = "mmg3d_O3 failed";
       }
@@ -469,10 +500,25 @@ int main(int argc, char** argv) {
     }
     cm::mesh::TetMesh p = m;
     perturb(p, 12345);
+    const fs::path perturbed_in = tmp / "perturbed.msh";
+    if (have_gmsh_python) cm::io::write_mesh(p, perturbed_in.string());
     const Row perturbed = optimize_ours(name + " perturbed", "curvemesh", std::move(p));
     print_row(perturbed, 0);
     print_worst(perturbed, worst_listed);
     rows.push_back(perturbed);
+    if (have_gmsh_python) {
+      Row g{name + " perturbed", "gmsh", perturbed.before, {}, {}, 0, 0, false, true, {}};
+      const fs::path out = tmp / "perturbed_gmsh.msh", log = tmp / "perturbed_gmsh.log";
+      if (gmsh_optimize_mesh(python, perturbed_in, out, log)) {
+        gmsh_optimizer_times(log, g.wall, g.cpu);
+        read_result(out, g);
+      } else {
+        g.note = fmt::format("gmsh's Python API failed (see {})", log.string());
+      }
+      print_row(g, perturbed.cpu);
+      print_worst(g, worst_listed);
+      rows.push_back(g);
+    }
   }
   for (const Row& r : rows) fmt::print("{}\n", to_json(r).dump());
   fs::remove_all(tmp);

@@ -9,7 +9,7 @@ pkgs=(
   libocct-data-exchange-dev
   libeigen3-dev libtbb-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
   pybind11-dev libgtest-dev libgmock-dev libbenchmark-dev libgmp-dev
-  gmsh
+  gmsh python3-gmsh
 )
 missing=()
 for p in "${pkgs[@]}"; do
