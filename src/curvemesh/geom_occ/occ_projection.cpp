@@ -37,6 +37,16 @@ namespace {
 
 constexpr int kMaxNewtonSteps = 60;
 constexpr int kMaxHalvings = 40;
+// Within kNearSteps convergence lengths of the minimum, the squared distance
+// of a point off the entity no longer tells a better point from a worse one
+// (a tangential error e changes it by e^2, below its rounding once e is
+// under about 1e-9 of the model's size), so a Newton step that does not
+// lower it is taken all the same: without this, most projections ended
+// with up to kMaxHalvings evaluations that could not decrease anything. A
+// step under kRoundSteps convergence lengths is rounding: the point is as
+// close as it gets.
+constexpr double kNearSteps = 1e6;
+constexpr double kRoundSteps = 1e-3;
 // Further Newton starts when the first ones leave the trimmed face.
 constexpr std::size_t kExtraStarts = 3;
 
@@ -145,6 +155,12 @@ NewtonResult newton_on_surface(const Geom_Surface& s, const Vec3& x, Vec2 uv, co
     // Across a period the model is the same again: no longer steps.
     for (int k = 0; k < 2; ++k)
       if (box.period[k] > 0) step[k] = std::clamp(step[k], -0.5 * box.period[k], 0.5 * box.period[k]);
+    // How far the step would move the point, to first order.
+    const double predicted = (sp.du * step.x() + sp.dv * step.y()).norm();
+    if (predicted <= kRoundSteps * eps_len) {
+      out.converged = true;
+      break;
+    }
     bool accepted = false;
     Vec2 next = uv;
     SurfacePoint sn;
@@ -153,6 +169,10 @@ NewtonResult newton_on_surface(const Geom_Surface& s, const Vec3& x, Vec2 uv, co
       next = into_box(uv + alpha * step, box);
       sn = eval(s, next);
       if ((sn.p - x).squaredNorm() <= f0) {
+        accepted = true;
+        break;
+      }
+      if (predicted <= kNearSteps * eps_len) {
         accepted = true;
         break;
       }
@@ -202,6 +222,13 @@ double newton_1d(const Jet& jet, const Vec3& x, double t, double lo, double hi, 
     if (!(h > 0)) break;
     double step = -g / h;
     if (period > 0) step = std::clamp(step, -0.5 * period, 0.5 * period);
+    // As on faces: a step at rounding level ends the iteration, and near the
+    // minimum one the distance cannot judge is taken.
+    const double predicted = std::abs(step) * c.d1.norm();
+    if (predicted <= kRoundSteps * eps_len) {
+      converged = true;
+      break;
+    }
     bool accepted = false;
     double next = t;
     CurveJet cn;
@@ -210,6 +237,10 @@ double newton_1d(const Jet& jet, const Vec3& x, double t, double lo, double hi, 
       next = keep(t + alpha * step);
       cn = jet(next);
       if ((cn.point - x).squaredNorm() <= r.squaredNorm()) {
+        accepted = true;
+        break;
+      }
+      if (predicted <= kNearSteps * eps_len) {
         accepted = true;
         break;
       }
@@ -329,16 +360,15 @@ geom::Projection OccModel::project_on_face(const FaceData& f, const Vec3& x,
                                            std::optional<Vec2> hint) const {
   const SearchBox box = search_box(f);
   const double eps_len = 1e-13 * scale_;
-  const auto finish = [&](const Vec2& uv) {
-    // Evaluated again (as face_derivatives does) so that the point is
-    // bitwise face_point(param).
-    const Vec3 p = eval(*f.surface, uv).p;
-    return geom::Projection{p, uv, (p - x).norm()};
+  // Newton's point is bitwise face_point(param): the same D2 call at the
+  // same parameters as face_derivatives makes.
+  const auto finish_newton = [&](const NewtonResult& r) {
+    return geom::Projection{r.point, r.uv, (r.point - x).norm()};
   };
   const auto inside = [&](const Vec2& uv) { return face_contains(f, uv); };
   if (hint) {
     const NewtonResult r = newton_on_surface(*f.surface, x, *hint, box, eps_len);
-    if (r.converged && inside(r.uv)) return finish(r.uv);
+    if (r.converged && inside(r.uv)) return finish_newton(r);
   }
   // Two starts: the nearest interior seed and the nearest boundary seed. A
   // point off a curved face can have a constrained local minimum on the
@@ -365,7 +395,7 @@ geom::Projection OccModel::project_on_face(const FaceData& f, const Vec3& x,
       left_face = r.uv;
       return;
     }
-    const geom::Projection p = finish(r.uv);
+    const geom::Projection p = finish_newton(r);
     if (!found || p.distance < found->distance) found = p;
   };
   for (const std::size_t seed : {nearest(0, grid_end), nearest(grid_end, all_end)})
