@@ -20,6 +20,12 @@ namespace {
 // percent on any edge a mesh edge spans.
 constexpr int kArcSamples = 32;
 
+// A node evaluated at interpolated (u, v) is kept when it lies within this
+// fraction of its polyline segment's length from the polyline: a smooth
+// face's arc over a segment strays a few percent (its sagitta), a
+// parametrization that is degenerate between the two points much more.
+constexpr double kMaxStray = 0.25;
+
 // Brings b within half a period of a in the periodic directions.
 double near_in_period(double a, double b, bool periodic, double period) {
   if (!periodic || !(period > 0)) return b;
@@ -70,17 +76,17 @@ void NodePlacer::edge_nodes(VertId a, VertId b, mesh::ModelRef on, Vec3* out) co
   }
   const int f = on.tag;
   std::optional<Vec2> ha = face_hint(a, f), hb = face_hint(b, f);
+  const geom::ParamRange r = model_.param_range({2, f});
   if (ha && hb) {
-    const geom::ParamRange r = model_.param_range({2, f});
     hb = Vec2(near_in_period(ha->x(), hb->x(), r.periodic_u, r.period_u),
               near_in_period(ha->y(), hb->y(), r.periodic_v, r.period_v));
   }
-  auto on_face = [&](double t) {
-    const std::optional<Vec2> hint = ha && hb ? std::optional<Vec2>(*ha + (*hb - *ha) * t) : (ha ? ha : hb);
-    return project_on_face(f, xa + (xb - xa) * t, hint);
+  auto hint_at = [&](double t) {
+    return ha && hb ? std::optional<Vec2>(*ha + (*hb - *ha) * t) : (ha ? ha : hb);
   };
+  auto on_face = [&](double t) { return model_.closest_point({2, f}, xa + (xb - xa) * t, hint_at(t)); };
   if (p == 2) {
-    out[0] = on_face(0.5);
+    out[0] = on_face(0.5).point;
     return;
   }
   // Projected chord points bunch toward the ends of an edge that bends
@@ -88,14 +94,33 @@ void NodePlacer::edge_nodes(VertId a, VertId b, mesh::ModelRef on, Vec3* out) co
   // against 26° for the others), and uneven nodes make det J vary. So the
   // chord fractions are corrected once: the polyline through the first
   // projections maps chord fraction to length, piecewise linearly, and the
-  // nodes are projected again from the fractions at equal lengths (within
-  // a fraction of a percent of the arc's thirds on a quarter circle).
+  // nodes are placed again at equal lengths (within a fraction of a percent
+  // of the arc's thirds on a quarter circle). With the vertices' (u, v)
+  // known, a corrected node is the face's point at the (u, v) interpolated
+  // the same way between the projections' parameters: one evaluation where
+  // a projection is several, and on the face by construction. Where that
+  // point strays from the polyline (a parametrization degenerate at a pole,
+  // a seam), it is projected from the chord instead.
   std::array<double, mesh::kMaxOrder + 1> t{}, length{};
   std::array<Vec3, mesh::kMaxOrder + 1> x{};
+  std::array<Vec2, mesh::kMaxOrder + 1> uv{};
+  const bool have_params = ha && hb;
   x[0] = xa;
   x[p] = xb;
+  if (have_params) {
+    uv[0] = *ha;
+    uv[p] = *hb;
+  }
   for (int s = 0; s <= p; ++s) t[s] = double(s) / p;
-  for (int s = 1; s < p; ++s) x[s] = on_face(t[s]);
+  for (int s = 1; s < p; ++s) {
+    const geom::Projection q = on_face(t[s]);
+    x[s] = q.point;
+    if (have_params) {
+      const Vec2 near = *hint_at(t[s]);
+      uv[s] = Vec2(near_in_period(near.x(), q.param.x(), r.periodic_u, r.period_u),
+                   near_in_period(near.y(), q.param.y(), r.periodic_v, r.period_v));
+    }
+  }
   for (int s = 1; s <= p; ++s) length[s] = length[s - 1] + (x[s] - x[s - 1]).norm();
   for (int s = 1; s < p; ++s) {
     const double target = length[p] * s / p;
@@ -103,7 +128,15 @@ void NodePlacer::edge_nodes(VertId a, VertId b, mesh::ModelRef on, Vec3* out) co
     while (k < p && length[k] < target) ++k;
     const double span = length[k] - length[k - 1];
     const double w = span > 0 ? (target - length[k - 1]) / span : 0.5;
-    out[s - 1] = on_face(t[k - 1] + w * (t[k] - t[k - 1]));
+    if (have_params) {
+      const Vec3 y = model_.face_point(f, uv[k - 1] + w * (uv[k] - uv[k - 1]));
+      const Vec3 on_polyline = x[k - 1] + w * (x[k] - x[k - 1]);
+      if ((y - on_polyline).norm() <= kMaxStray * span) {
+        out[s - 1] = y;
+        continue;
+      }
+    }
+    out[s - 1] = on_face(t[k - 1] + w * (t[k] - t[k - 1])).point;
   }
 }
 
