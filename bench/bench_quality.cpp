@@ -101,6 +101,21 @@ void BM_ShapeMeasure(benchmark::State& state) {
 }
 BENCHMARK(BM_ShapeMeasure)->Arg(2)->Arg(3);
 
+// The same measure from det J's Bézier coefficients, as the curving check
+// computes it after the certification.
+void BM_ShapeMeasureFromBezier(benchmark::State& state) {
+  const int p = static_cast<int>(state.range(0));
+  std::vector<std::vector<double>> coefs;
+  for (const auto& nodes : curved_valid_tets(p, 0.03)) coefs.push_back(q::jacobian_bezier_coefficients(p, nodes));
+  for (auto _ : state) {
+    double acc = 0;
+    for (const auto& c : coefs) acc += q::shape_measure_from_bezier(p, c).measure;
+    benchmark::DoNotOptimize(acc);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * kTets);
+}
+BENCHMARK(BM_ShapeMeasureFromBezier)->Arg(2)->Arg(3);
+
 }  // namespace
 
 BENCHMARK_MAIN();

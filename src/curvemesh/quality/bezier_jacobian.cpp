@@ -35,9 +35,17 @@ struct OrderTables {
   int num_nodes = 0;
   int num_derivs = 0;  // Bernstein basis of degree p-1
   int num_coefs = 0;   // Bernstein basis of degree 3(p-1)
-  // Control point of rank m = sum_n lag2bez[m * num_nodes + n] * node n.
-  std::vector<double> lag2bez;
+  // Control point of rank m = sum_n L(m, n) * node n, L stored by rows
+  // without its zeros (a control point of an edge depends on the nodes of
+  // that edge alone, of a face on its closure): row m is the entries
+  // [row_start[m], row_start[m + 1]) of lag2bez_sparse, by increasing node.
   double lag2bez_norm = 0;  // max row sum of |entries|
+  struct Entry {
+    int node;
+    double weight;
+  };
+  std::vector<Entry> lag2bez_sparse;
+  std::vector<int> row_start;
   // d/dxi_j control point of rank b = p (c[plus[j][b]] - c[base[b]]).
   std::array<std::vector<int>, 3> plus;
   std::vector<int> base;
@@ -113,14 +121,18 @@ OrderTables build_order_tables(int p) {
       eval(n, m) = v;
     }
   const MatL inverse = eval.inverse();
-  t.lag2bez.resize(static_cast<std::size_t>(t.num_nodes * t.num_nodes));
+  t.row_start.push_back(0);
   for (int m = 0; m < t.num_nodes; ++m) {
     double row = 0;
     for (int n = 0; n < t.num_nodes; ++n) {
-      const double v = static_cast<double>(inverse(m, n));
-      t.lag2bez[static_cast<std::size_t>(m * t.num_nodes + n)] = v;
+      // Entries that are zero in exact arithmetic come out of the inversion
+      // as rounding residue; the others are ratios of small integers.
+      double v = static_cast<double>(inverse(m, n));
+      if (std::abs(v) < 1e-12) v = 0;
       row += std::abs(v);
+      if (v != 0 && n > 0) t.lag2bez_sparse.push_back({n, v});
     }
+    t.row_start.push_back(static_cast<int>(t.lag2bez_sparse.size()));
     t.lag2bez_norm = std::max(t.lag2bez_norm, row);
   }
 
@@ -213,10 +225,13 @@ double compute_control_points(const OrderTables& t, std::span<const Vec3> nodes,
     rel[static_cast<std::size_t>(n)] = nodes[static_cast<std::size_t>(n)] - nodes[0];
     scale = std::max(scale, rel[static_cast<std::size_t>(n)].cwiseAbs().maxCoeff());
   }
+  // Node 0's column never counts: its translated position is zero.
   for (int m = 0; m < t.num_nodes; ++m) {
-    const double* row = t.lag2bez.data() + static_cast<std::size_t>(m * t.num_nodes);
     Vec3 c = Vec3::Zero();
-    for (int n = 1; n < t.num_nodes; ++n) c += row[n] * rel[static_cast<std::size_t>(n)];
+    for (int k = t.row_start[static_cast<std::size_t>(m)]; k < t.row_start[static_cast<std::size_t>(m) + 1]; ++k) {
+      const auto& [n, w] = t.lag2bez_sparse[static_cast<std::size_t>(k)];
+      c += w * rel[static_cast<std::size_t>(n)];
+    }
     control[m] = c;
   }
   return scale;
