@@ -56,8 +56,7 @@ nlohmann::json curve_report_json(const curved::CurveReport& r) {
                      {"unacceptable", r.after.unacceptable.size()},
                      {"min_scaled_jacobian", r.after.min_scaled_jacobian},
                      {"mean_scaled_jacobian", r.after.mean_scaled_jacobian},
-                     {"min_measure", r.after.min_measure},
-                     {"mean_measure", r.after.mean_measure}}},
+                     {"min_measure", r.after.min_measure}}},
           {"problems", {{"too_far_from_straight", s.too_far}, {"too_close", s.too_close}, {"listed", listed}}},
           {"operations", {{"edge_removals", s.edge_removals},
                           {"face_swaps", s.face_swaps},
@@ -94,10 +93,9 @@ void print_curve_report(const curved::CurveReport& r) {
                "relocations, {} interior edges curved, {} boundary edges straightened, in {} passes\n",
                s.too_far, s.too_close, s.edge_removals, s.face_swaps, s.boundary_swaps, s.deletions, s.splits,
                s.collapses, s.relocations, s.interior_edges_curved, s.edges_straightened, s.passes);
-  fmt::print("  after: {} certified invalid, {} unacceptable; scaled Jacobian min {:.4f} mean {:.4f}; I min {:.4f} "
-             "mean {:.4f}\n",
+  fmt::print("  after: {} certified invalid, {} unacceptable; scaled Jacobian min {:.4f} mean {:.4f}; I min {:.4f}\n",
              r.after.invalid.size(), r.after.unacceptable.size(), r.after.min_scaled_jacobian,
-             r.after.mean_scaled_jacobian, r.after.min_measure, r.after.mean_measure);
+             r.after.mean_scaled_jacobian, r.after.min_measure);
   fmt::print("  geometric error (boundary to model, {} samples): straight max {:.4g} mean {:.4g}, curved max {:.4g} "
              "mean {:.4g}\n",
              r.error_curved.samples, r.error_straight.max, r.error_straight.mean, r.error_curved.max,

@@ -80,8 +80,8 @@ CurveReport curve_mesh(mesh::TetMesh& m, const geom::Model& model, const CurveOp
   r.placement = place_boundary_nodes(m, model, o.order);
   r.place_seconds = step.seconds();
   step.reset();
-  // Before: what to repair, with exact measures so that the report after
-  // the repair redoes only the tets whose nodes it changed.
+  // Before: what to repair, keeping every curved tet's result so that the
+  // report after the repair redoes only the tets whose nodes it changed.
   CheckCache seen;
   const MeshCheck before = check_mesh(m, o.repair.acceptance, true, nullptr, &seen);
   r.invalid_before = before.invalid.size();
@@ -97,7 +97,7 @@ CurveReport curve_mesh(mesh::TetMesh& m, const geom::Model& model, const CurveOp
     mesh::drop_unused_vertices(m);
   }
   step.reset();
-  // Untouched, the mesh checks as it did (the same exact measures).
+  // Untouched, the mesh checks as it did.
   r.after = repairs ? check_mesh(m, o.repair.acceptance, true, &seen) : before;
   r.check_seconds += step.seconds();
   step.reset();

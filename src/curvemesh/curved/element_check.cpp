@@ -175,7 +175,7 @@ ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& accept
   return check_element(m.high_order.order(), mesh::tet_nodes(m, m.tet2verts[t]).view(), acceptance, exact_measure);
 }
 
-MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures,
+MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_min_measure,
                      const CheckCache* reuse, CheckCache* keep) {
   const std::size_t nt = m.num_tets();
   const int order = m.high_order.order();
@@ -204,19 +204,15 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
       const mesh::TetNodes gathered = mesh::tet_nodes(m, m.tet2verts[tet]);
       const std::span<const Vec3> nodes = gathered.view();
       const ElementCheck* known = reuse ? reuse->find(nodes) : nullptr;
-      if (known && (known->measure_exact || !exact_measures))
-        checks[t] = *known;
-      else
-        checks[t] = check_element(order, nodes, acceptance, exact_measures);
+      checks[t] = known ? *known : check_element(order, nodes, acceptance);
       if (keep) {
         std::copy(nodes.begin(), nodes.end(), keep->nodes_.begin() + std::ptrdiff_t(std::size_t(entry[t]) * per_tet));
         keep->checks_[entry[t]] = checks[t];
       }
     }
   });
-  if (keep) keep->index_all();
   MeshCheck out;
-  double sum_sj = 0, sum_i = 0;
+  double sum_sj = 0;
   for (std::size_t t = 0; t < nt; ++t) {
     const ElementCheck& c = checks[t];
     if (c.verdict != quality::Validity::kValid) out.invalid.push_back(static_cast<TetId>(t));
@@ -225,12 +221,31 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
     out.min_scaled_jacobian = std::min(out.min_scaled_jacobian, c.scaled_jacobian);
     out.min_measure = std::min(out.min_measure, c.measure);
     sum_sj += c.scaled_jacobian;
-    sum_i += c.measure;
   }
-  if (nt) {
-    out.mean_scaled_jacobian = sum_sj / double(nt);
-    out.mean_measure = sum_i / double(nt);
+  if (nt) out.mean_scaled_jacobian = sum_sj / double(nt);
+  if (exact_min_measure) {
+    // A measure that is not exact is a lower bound of I (the certified
+    // scaled Jacobian), so only tets whose bound is under the least exact I
+    // found can hold the minimum: those are measured, lowest bound first.
+    double least = 1;
+    std::vector<std::pair<double, TetId>> open;
+    for (std::size_t t = 0; t < nt; ++t) {
+      if (checks[t].measure_exact)
+        least = std::min(least, checks[t].measure);
+      else
+        open.emplace_back(checks[t].measure, static_cast<TetId>(t));
+    }
+    std::sort(open.begin(), open.end());
+    for (const auto& [bound, t] : open) {
+      if (bound >= least) break;
+      ElementCheck& c = checks[t];
+      c = check_element(order, mesh::tet_nodes(m, m.tet2verts[t]).view(), acceptance, true);
+      least = std::min(least, c.measure);
+      if (keep && entry[t + 1] != entry[t]) keep->checks_[entry[t]] = c;
+    }
+    out.min_measure = least;
   }
+  if (keep) keep->index_all();
   return out;
 }
 

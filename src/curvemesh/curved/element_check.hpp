@@ -77,10 +77,11 @@ struct MeshCheck {
   std::vector<TetId> unacceptable;  ///< not acceptable (includes the invalid ones)
   std::size_t undetermined = 0;
   double min_scaled_jacobian = 1, mean_scaled_jacobian = 1;
-  double min_measure = 1, mean_measure = 1;
+  /// Least I of eq. (3.5) (a lower bound unless asked exact).
+  double min_measure = 1;
 };
 class CheckCache;
-MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures,
+MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_min_measure,
                      const CheckCache* reuse, CheckCache* keep);
 
 /// Check results keyed by the tet's nodes, compared exactly (never by tet
@@ -120,12 +121,15 @@ class CheckCache {
   std::vector<Slot> by_hash_;
 };
 
-/// With `exact_measures` false the measure statistics are lower bounds
-/// (see check_element); the verdicts and lists are the same either way.
-/// With `reuse`, results of tets found there are taken as they are (only
-/// those computed with exact measures, when exact_measures is asked);
-/// with `keep`, the curved tets' nodes and results are stored there.
-MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_measures = true,
+/// Verdicts, lists and scaled Jacobians are certified either way. I is
+/// computed where it decides acceptability (check_element); with
+/// `exact_min_measure` also where it could be the least over the mesh, so
+/// that min_measure is exact (a few tets: I is at least the certified
+/// scaled Jacobian bound, so tets whose bound clears the least I found need
+/// not be measured). With `reuse`, results of tets found there are taken as
+/// they are; with `keep`, the curved tets' nodes and results are stored
+/// there.
+MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_min_measure = true,
                      const CheckCache* reuse = nullptr, CheckCache* keep = nullptr);
 
 }  // namespace cm::curved
