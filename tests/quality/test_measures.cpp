@@ -127,6 +127,44 @@ TEST(Measures, InvariantUnderSimilarity) {
   }
 }
 
+// The optimizer's cheaper minimum agrees with the range's on random tets,
+// slivers, needles, inverted and flat ones.
+TEST(Measures, MinDihedralIsTheRangesMinimum) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::array<Vec3, 4> v;
+    for (auto& x : v) x = Vec3(u(rng), u(rng), u(rng));
+    if (trial % 4 == 1) v[3] = (v[0] + v[1] + v[2]) / 3 + 1e-4 * Vec3(u(rng), u(rng), u(rng));  // sliver or cap
+    if (trial % 4 == 2) v[1] = v[0] + 1e-3 * Vec3(u(rng), u(rng), u(rng));                         // needle
+    const double range_min = tet_dihedral_range(v[0], v[1], v[2], v[3]).min;
+    EXPECT_NEAR(tet_min_dihedral(v[0], v[1], v[2], v[3]), range_min, 1e-9) << "trial " << trial;
+  }
+  const Vec3 p0(0, 0, 0), p1(1, 0, 0), p2(1, 1, 0), p3(0, 1, 0);
+  EXPECT_NEAR(tet_min_dihedral(p0, p1, p2, p3), 0, 1e-12);
+  EXPECT_EQ(tet_min_dihedral(p0, p0, p1, p2), 0);
+}
+
+// The mean ratio's cube root is a fast one: against a long double
+// reference over a wide range of tet sizes and shapes.
+TEST(Measures, MeanRatioIsAccurateAtEveryScale) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1), e(-60, 60);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double s = std::exp2(e(rng));
+    std::array<Vec3, 4> v;
+    for (auto& x : v) x = s * Vec3(u(rng), u(rng), u(rng));
+    using L = long double;
+    const L vol = L((v[1] - v[0]).cross(v[2] - v[0]).dot(v[3] - v[0])) / 6;
+    L sum = 0;
+    for (const auto& ed : cm::mesh::kTetEdges) sum += L((v[ed[1]] - v[ed[0]]).squaredNorm());
+    const L ref = 12 * std::cbrt(9 * vol * vol) / sum * (vol > 0 ? 1 : -1);
+    EXPECT_NEAR(tet_mean_ratio(v[0], v[1], v[2], v[3]), double(ref), 1e-13) << "trial " << trial;
+  }
+  const Vec3 a(1, 1, 1), b(1, -1, -1), c(-1, -1, 1), d(-1, 1, -1);
+  EXPECT_NEAR(tet_mean_ratio(a, b, c, d), 1.0, 4e-16);
+}
+
 TEST(Measures, MetricVersions) {
   const Mat3 m = Vec3(4, 1, 9).asDiagonal();
   EXPECT_DOUBLE_EQ(metric_length(Vec3(1, 0, 0), m), 2);

@@ -52,7 +52,7 @@ double best_mean_ratio_at_angle(const Vec3& a, const Vec3& b, const Vec3& c, con
   // 1 + the mean ratio, so an infeasible start climbs the angle first.
   auto score = [&](const Vec3& x) {
     const Vec3 d = g + scale * (x[0] * e1 + x[1] * e2 + x[2] * n);
-    const double angle = quality::tet_dihedral_range(a, b, c, d).min;
+    const double angle = quality::tet_min_dihedral(a, b, c, d);
     if (angle < target) return angle / target;
     return 1 + std::max(quality::tet_mean_ratio(a, b, c, d), quality::tet_mean_ratio(a, c, b, d));
   };
@@ -109,7 +109,7 @@ BoundaryLimit classify_boundary_limit(const mesh::TetMesh& m, double target, std
   for (TetId t = 0; t < m.num_tets(); ++t) {
     const auto& v = m.tet2verts[t];
     const Vec3 &p0 = m.coords[v[0]], &p1 = m.coords[v[1]], &p2 = m.coords[v[2]], &p3 = m.coords[v[3]];
-    const double d = quality::tet_dihedral_range(p0, p1, p2, p3).min;
+    const double d = quality::tet_min_dihedral(p0, p1, p2, p3);
     if (d < target) {
       BoundaryLimit::Tet b;
       b.tet = t;
@@ -190,7 +190,7 @@ BoundaryLimit classify_boundary_limit(const mesh::TetMesh& m, double target, std
     const auto& v = m.tet2verts[t];
     const Vec3 &p0 = m.coords[v[0]], &p1 = m.coords[v[1]], &p2 = m.coords[v[2]], &p3 = m.coords[v[3]];
     r.free_min_mean_ratio = std::min(r.free_min_mean_ratio, quality::tet_mean_ratio(p0, p1, p2, p3));
-    r.free_min_dihedral = std::min(r.free_min_dihedral, quality::tet_dihedral_range(p0, p1, p2, p3).min);
+    r.free_min_dihedral = std::min(r.free_min_dihedral, quality::tet_min_dihedral(p0, p1, p2, p3));
   }
   if (bad.size() > worst) bad.resize(worst);
   r.worst = std::move(bad);

@@ -31,7 +31,7 @@ struct Summary {
 
 double min_dihedral(const mesh::TetMesh& m, TetId t) {
   const auto& v = m.tet2verts[t];
-  return quality::tet_dihedral_range(m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]).min;
+  return quality::tet_min_dihedral(m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]);
 }
 
 Summary summarize(const modify::MeshEditor& ed, double threshold) {

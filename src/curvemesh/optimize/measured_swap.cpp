@@ -14,7 +14,7 @@ namespace cm::optimize {
 double angle_aware_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return -1;
   constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
-  const double angle = quality::tet_dihedral_range(a, b, c, d).min / kRegularDihedral;
+  const double angle = quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral;
   return std::max(std::min(quality::tet_mean_ratio(a, b, c, d), angle), 0.0);
 }
 
@@ -22,7 +22,7 @@ std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, con
   if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return {-1, -1};
   constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
   const double mr = std::max(quality::tet_mean_ratio(a, b, c, d), 0.0);
-  return {mr, std::min(mr, quality::tet_dihedral_range(a, b, c, d).min / kRegularDihedral)};
+  return {mr, std::min(mr, quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral)};
 }
 
 double mean_ratio_floor(double mr_before, double shape_before) {

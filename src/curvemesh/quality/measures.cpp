@@ -2,7 +2,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 
@@ -19,13 +21,40 @@ double sum_squared_edges(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
          (d - a).squaredNorm() + (d - b).squaredNorm() + (d - c).squaredNorm();
 }
 
+// Cube root of a positive normal double to a few ulps: the exponent divided
+// by three in the bit pattern, then three Halley steps (cubic convergence
+// from a start within a few percent). libm's cbrt is correctly rounded and
+// three times slower, and the mean ratio, which needs one, is evaluated
+// millions of times by the optimizer.
+double cube_root(double x) {
+  if (!(x >= std::numeric_limits<double>::min() && x <= std::numeric_limits<double>::max())) return std::cbrt(x);
+  double y = std::bit_cast<double>(std::bit_cast<std::uint64_t>(x) / 3 + 0x2a9f7893782da1ceull);
+  for (int k = 0; k < 3; ++k) {
+    const double y3 = y * y * y;
+    y *= (y3 + 2 * x) / (2 * y3 + x);
+  }
+  return y;
+}
+
 // Shared by the isotropic and metric forms: eta from a signed volume and the
 // sum of squared edge lengths measured in the same metric.
 double mean_ratio_from(double volume, double sum_sq) {
   if (!(sum_sq > 0) || volume == 0) return 0;
-  const double eta = 12.0 * std::cbrt(9.0 * volume * volume) / sum_sq;
+  const double eta = 12.0 * cube_root(9.0 * volume * volume) / sum_sq;
   return volume > 0 ? eta : -eta;
 }
+
+// The two faces through edge e of kTetEdges: those opposite its other two
+// vertices.
+constexpr std::array<std::array<int, 2>, 6> kOtherFaces = [] {
+  std::array<std::array<int, 2>, 6> o{};
+  for (int e = 0; e < 6; ++e) {
+    int count = 0;
+    for (int k = 0; k < 4; ++k)
+      if (k != mesh::kTetEdges[e][0] && k != mesh::kTetEdges[e][1]) o[e][count++] = k;
+  }
+  return o;
+}();
 
 // Normals (right-hand rule over kFaceVerts) of the 4 faces, each of length
 // twice the face area; outward for a positive tet.
@@ -140,6 +169,33 @@ AngleRange tet_dihedral_range(const Vec3& a, const Vec3& b, const Vec3& c, const
     return 180.0 - std::atan2(sc[e][0], sc[e][1]) * kRadToDeg;
   };
   return {angle(lo, lo_key), angle(hi, hi_key)};
+}
+
+double tet_min_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const auto n = face_normals({&a, &b, &c, &d});
+  std::array<double, 4> inverse_norm;
+  for (int f = 0; f < 4; ++f) {
+    const double sq = n[f].squaredNorm();
+    if (sq == 0) return 0;  // a degenerate face: angle 0, as tet_dihedral_angles says
+    inverse_norm[f] = 1 / std::sqrt(sq);
+  }
+  // The interior angle at an edge is 180 degrees minus the angle between
+  // the normals of the two faces through it: the smallest is where the unit
+  // normals' dot product is least. Its value as tet_dihedral_range computes
+  // it, with atan2's precision near 0 degrees.
+  double least = INFINITY;
+  int at = 0;
+  for (int e = 0; e < 6; ++e) {
+    const auto& o = kOtherFaces[e];
+    const double cs = n[o[0]].dot(n[o[1]]) * (inverse_norm[o[0]] * inverse_norm[o[1]]);
+    if (cs < least) {
+      least = cs;
+      at = e;
+    }
+  }
+  const Vec3& nk = n[kOtherFaces[at][0]];
+  const Vec3& nl = n[kOtherFaces[at][1]];
+  return 180.0 - std::atan2(nk.cross(nl).norm(), nk.dot(nl)) * kRadToDeg;
 }
 
 double metric_length(const Vec3& e, const Mat3& metric) {
