@@ -290,6 +290,9 @@ std::optional<Vec2> check_hint(const mesh::TetMesh& m, const std::array<VertId, 
 
 bool agrees_with_model(const geom::Model& model, int face, const Vec3& a, const Vec3& b, const Vec3& c,
                        std::optional<Vec2> hint) {
+  // A plane's normal is the same at every parameter: no projection needed.
+  if (model.type({2, face}) == geom::ShapeType::kPlane)
+    return tri_normal(a, b, c).dot(model.face_normal(face, hint.value_or(Vec2::Zero()))) > 0;
   const geom::Projection p = model.closest_point({2, face}, (a + b + c) / 3, hint);
   return tri_normal(a, b, c).dot(model.face_normal(face, p.param)) > 0;
 }
