@@ -5,6 +5,9 @@
 #include <span>
 #include <utility>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "curvemesh/core/timer.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 #include "curvemesh/mesh/topology.hpp"
@@ -34,17 +37,27 @@ double min_dihedral(const mesh::TetMesh& m, TetId t) {
   return quality::tet_min_dihedral(m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]);
 }
 
+// The measures in parallel, the sums in tet order (the same result for any
+// number of threads).
 Summary summarize(const modify::MeshEditor& ed, double threshold) {
   const auto& m = ed.mesh();
+  const std::size_t nt = m.tet2verts.size();
+  std::vector<double> q(nt), angle(nt);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      if (ed.is_dead(static_cast<TetId>(t))) continue;
+      q[t] = modify::tet_quality(m, m.tet2verts[t]);
+      angle[t] = min_dihedral(m, static_cast<TetId>(t));
+    }
+  });
   Summary s;
   std::size_t n = 0;
-  for (TetId t = 0; t < m.tet2verts.size(); ++t) {
-    if (ed.is_dead(t)) continue;
-    const double q = modify::tet_quality(m, m.tet2verts[t]);
-    s.min = std::min(s.min, q);
-    s.min_dihedral = std::min(s.min_dihedral, min_dihedral(m, t));
-    s.mean += q;
-    s.below += q < threshold;
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (ed.is_dead(static_cast<TetId>(t))) continue;
+    s.min = std::min(s.min, q[t]);
+    s.min_dihedral = std::min(s.min_dihedral, angle[t]);
+    s.mean += q[t];
+    s.below += q[t] < threshold;
     ++n;
   }
   s.mean = n ? s.mean / static_cast<double>(n) : 0;
@@ -280,13 +293,21 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
     }
     touched.clear();
     bad.clear();
-    for (TetId t : candidates) {
-      if (ed.is_dead(t)) continue;
-      const double q = modify::tet_quality(m, m.tet2verts[t]);
-      // Worst angle-aware shape first: slivers before fair-angled tets of
-      // the same mean ratio.
-      if (needs_work(m, t, q, o)) bad.emplace_back(shape(m, t), t);
-    }
+    // Which candidates need work, and how badly, measured in parallel (the
+    // first pass measures every tet); listed in candidate order.
+    std::vector<double> badness(candidates.size(), -2);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const TetId t = candidates[i];
+                          if (ed.is_dead(t)) continue;
+                          // Worst angle-aware shape first: slivers before
+                          // fair-angled tets of the same mean ratio.
+                          if (needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o)) badness[i] = shape(m, t);
+                        }
+                      });
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      if (badness[i] > -2) bad.emplace_back(badness[i], candidates[i]);
     if (bad.empty()) break;
     std::sort(bad.begin(), bad.end());
     if (!(bad.front().first > last_worst + 1e-6) && st.passes > 0) stuck = true;
