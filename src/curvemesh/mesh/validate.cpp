@@ -1,10 +1,14 @@
 #include "curvemesh/mesh/validate.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <map>
 #include <set>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
@@ -58,24 +62,40 @@ TriKey sorted_key(VertId a, VertId b, VertId c) {
   return k;
 }
 
+// The per-tet and per-face tests run in parallel into status arrays; the
+// issues are then reported in tet order, as a serial pass would.
 bool check_tets(const TetMesh& m, Reporter& rep) {
-  bool ids_ok = true;
+  enum : std::uint8_t { kOk, kBadId, kDuplicate, kNegative, kZero };
   const auto nv = static_cast<VertId>(m.num_verts());
+  std::vector<std::uint8_t> status(m.num_tets(), kOk);
+  tbb::parallel_for(tbb::blocked_range<TetId>(0, static_cast<TetId>(m.num_tets()), 4096),
+                    [&](const tbb::blocked_range<TetId>& r) {
+                      for (TetId t = r.begin(); t != r.end(); ++t) {
+                        const auto& v = m.tet2verts[t];
+                        if (v[0] >= nv || v[1] >= nv || v[2] >= nv || v[3] >= nv) {
+                          status[t] = kBadId;
+                        } else if (v[0] == v[1] || v[0] == v[2] || v[0] == v[3] || v[1] == v[2] || v[1] == v[3] ||
+                                   v[2] == v[3]) {
+                          status[t] = kDuplicate;
+                        } else {
+                          const int s = predicates::orient3d(m.coords[v[0]].data(), m.coords[v[1]].data(),
+                                                             m.coords[v[2]].data(), m.coords[v[3]].data());
+                          status[t] = s < 0 ? kNegative : s == 0 ? kZero : kOk;
+                        }
+                      }
+                    });
+  bool ids_ok = true;
   for (TetId t = 0; t < m.num_tets(); ++t) {
-    const auto& v = m.tet2verts[t];
-    if (v[0] >= nv || v[1] >= nv || v[2] >= nv || v[3] >= nv) {
-      rep.add(Kind::kBadVertexId, t, fmt::format("tet {} references a vertex >= {}", t, nv));
-      ids_ok = false;
-      continue;
+    switch (status[t]) {
+      case kBadId:
+        rep.add(Kind::kBadVertexId, t, fmt::format("tet {} references a vertex >= {}", t, nv));
+        ids_ok = false;
+        break;
+      case kDuplicate: rep.add(Kind::kDuplicateVertex, t, fmt::format("tet {} uses a vertex twice", t)); break;
+      case kNegative: rep.add(Kind::kInverted, t, fmt::format("tet {} is inverted (negative volume)", t)); break;
+      case kZero: rep.add(Kind::kFlat, t, fmt::format("tet {} is flat (zero volume)", t)); break;
+      default: break;
     }
-    if (v[0] == v[1] || v[0] == v[2] || v[0] == v[3] || v[1] == v[2] || v[1] == v[3] || v[2] == v[3]) {
-      rep.add(Kind::kDuplicateVertex, t, fmt::format("tet {} uses a vertex twice", t));
-      continue;
-    }
-    const int s = predicates::orient3d(m.coords[v[0]].data(), m.coords[v[1]].data(),
-                                       m.coords[v[2]].data(), m.coords[v[3]].data());
-    if (s < 0) rep.add(Kind::kInverted, t, fmt::format("tet {} is inverted (negative volume)", t));
-    if (s == 0) rep.add(Kind::kFlat, t, fmt::format("tet {} is flat (zero volume)", t));
   }
   return ids_ok;
 }
@@ -85,22 +105,35 @@ void check_adjacency(const TetMesh& m, Reporter& rep) {
     rep.add(Kind::kAdjacencyAsymmetric, -1, "adjacency not built for all tets");
     return;
   }
+  enum : std::uint8_t { kOk, kNoPointBack, kWrongFace };
+  std::vector<std::uint8_t> status(m.tet2adj.size(), kOk);
+  tbb::parallel_for(tbb::blocked_range<TetId>(0, static_cast<TetId>(m.num_tets()), 4096),
+                    [&](const tbb::blocked_range<TetId>& r) {
+                      for (TetId t = r.begin(); t != r.end(); ++t)
+                        for (int f = 0; f < 4; ++f) {
+                          const Index here = pack_face(t, f);
+                          const Index there = m.tet2adj[here];
+                          if (there == kNone) continue;
+                          if (face_tet(there) >= m.num_tets() || m.tet2adj[there] != here) {
+                            status[here] = kNoPointBack;
+                            continue;
+                          }
+                          const auto& a = m.tet2verts[t];
+                          const auto& b = m.tet2verts[face_tet(there)];
+                          const int g = face_index(there);
+                          if (sorted_key(a[kFaceVerts[f][0]], a[kFaceVerts[f][1]], a[kFaceVerts[f][2]]) !=
+                              sorted_key(b[kFaceVerts[g][0]], b[kFaceVerts[g][1]], b[kFaceVerts[g][2]]))
+                            status[here] = kWrongFace;
+                        }
+                    });
   for (TetId t = 0; t < m.num_tets(); ++t)
     for (int f = 0; f < 4; ++f) {
       const Index here = pack_face(t, f);
-      const Index there = m.tet2adj[here];
-      if (there == kNone) continue;
-      if (face_tet(there) >= m.num_tets() || m.tet2adj[there] != here) {
+      if (status[here] == kNoPointBack)
         rep.add(Kind::kAdjacencyAsymmetric, here, fmt::format("tet {} face {}: neighbour does not point back", t, f));
-        continue;
-      }
-      const auto& a = m.tet2verts[t];
-      const auto& b = m.tet2verts[face_tet(there)];
-      const int g = face_index(there);
-      const TriKey ka = sorted_key(a[kFaceVerts[f][0]], a[kFaceVerts[f][1]], a[kFaceVerts[f][2]]);
-      const TriKey kb = sorted_key(b[kFaceVerts[g][0]], b[kFaceVerts[g][1]], b[kFaceVerts[g][2]]);
-      if (ka != kb)
-        rep.add(Kind::kAdjacencyWrongFace, here, fmt::format("tet {} face {}: neighbour {} does not share it", t, f, face_tet(there)));
+      else if (status[here] == kWrongFace)
+        rep.add(Kind::kAdjacencyWrongFace, here,
+                fmt::format("tet {} face {}: neighbour {} does not share it", t, f, face_tet(m.tet2adj[here])));
     }
 }
 
@@ -109,14 +142,19 @@ void check_adjacency(const TetMesh& m, Reporter& rep) {
 // Returns the boundary faces: hull faces and faces between different regions,
 // each with the tet that owns it.
 std::vector<std::pair<TriKey, Index>> check_conformity(const TetMesh& m, Reporter& rep) {
-  std::vector<std::pair<TriKey, Index>> faces;
-  faces.reserve(4 * m.num_tets());
-  for (TetId t = 0; t < m.num_tets(); ++t) {
-    const auto& v = m.tet2verts[t];
-    for (int f = 0; f < 4; ++f)
-      faces.push_back({sorted_key(v[kFaceVerts[f][0]], v[kFaceVerts[f][1]], v[kFaceVerts[f][2]]), pack_face(t, f)});
-  }
-  std::sort(faces.begin(), faces.end());
+  // Keys are distinct (each carries its own face), so the parallel sort's
+  // order is the serial one.
+  std::vector<std::pair<TriKey, Index>> faces(4 * m.num_tets());
+  tbb::parallel_for(tbb::blocked_range<TetId>(0, static_cast<TetId>(m.num_tets()), 4096),
+                    [&](const tbb::blocked_range<TetId>& r) {
+                      for (TetId t = r.begin(); t != r.end(); ++t) {
+                        const auto& v = m.tet2verts[t];
+                        for (int f = 0; f < 4; ++f)
+                          faces[pack_face(t, f)] = {sorted_key(v[kFaceVerts[f][0]], v[kFaceVerts[f][1]], v[kFaceVerts[f][2]]),
+                                                    pack_face(t, f)};
+                      }
+                    });
+  tbb::parallel_sort(faces.begin(), faces.end());
   std::vector<std::pair<TriKey, Index>> boundary;
   for (std::size_t i = 0; i < faces.size();) {
     std::size_t j = i + 1;
