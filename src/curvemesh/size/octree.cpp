@@ -126,7 +126,7 @@ SizeOctree::SizeOctree(const geom::BoundingBox& box, const OctreeOptions& option
     throw std::invalid_argument("size octree: the bounding box is empty");
   side_ = 1.02 * extent.maxCoeff();
   origin_ = 0.5 * (box.min + box.max) - Vec3::Constant(0.5 * side_);
-  octants_.push_back({0, 0, 0, -1, 0});
+  octants_.push_back({0, 0, 0, -1, 0, 0});
 }
 
 std::array<std::uint32_t, 3> SizeOctree::to_units(const Vec3& x) const {
@@ -156,6 +156,21 @@ std::uint32_t SizeOctree::find(std::uint32_t ix, std::uint32_t iy, std::uint32_t
   return o;
 }
 
+std::uint32_t SizeOctree::find_near(std::uint32_t o, std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const {
+  for (;;) {
+    const Octant& q = octants_[o];
+    const std::uint32_t s = units(q.level);
+    if (q.level == 0 || (ix - q.ix < s && iy - q.iy < s && iz - q.iz < s)) break;  // unsigned: below is huge
+    o = q.parent;
+  }
+  while (octants_[o].first_child >= 0) {
+    const int bit = opt_.max_depth - octants_[o].level - 1;
+    const std::uint32_t child = ((ix >> bit) & 1u) | (((iy >> bit) & 1u) << 1) | (((iz >> bit) & 1u) << 2);
+    o = static_cast<std::uint32_t>(octants_[o].first_child) + child;
+  }
+  return o;
+}
+
 void SizeOctree::split(std::uint32_t o) {
   const Octant parent = octants_[o];
   CM_ASSERT(parent.first_child < 0 && parent.level < opt_.max_depth);
@@ -163,7 +178,7 @@ void SizeOctree::split(std::uint32_t o) {
   octants_[o].first_child = static_cast<std::int32_t>(octants_.size());
   for (int c = 0; c < 8; ++c)
     octants_.push_back({parent.ix + kCorner[c][0] * half, parent.iy + kCorner[c][1] * half,
-                        parent.iz + kCorner[c][2] * half, -1, static_cast<std::uint8_t>(parent.level + 1)});
+                        parent.iz + kCorner[c][2] * half, -1, static_cast<std::uint8_t>(parent.level + 1), o});
 }
 
 void SizeOctree::insert(const Vec3& x, double h, SizeSource source) {
@@ -236,8 +251,9 @@ void SizeOctree::balance(std::vector<std::uint32_t> work) {
           const auto probe = [&](std::int64_t lo, int d) { return d < 0 ? lo - 1 : d > 0 ? lo + s : lo; };
           const std::int64_t px = probe(me.ix, dx), py = probe(me.iy, dy), pz = probe(me.iz, dz);
           if (px < 0 || py < 0 || pz < 0 || px >= top || py >= top || pz >= top) continue;
+          std::uint32_t q = o;
           for (;;) {
-            const std::uint32_t q = find(std::uint32_t(px), std::uint32_t(py), std::uint32_t(pz));
+            q = find_near(q, std::uint32_t(px), std::uint32_t(py), std::uint32_t(pz));
             if (octants_[q].level + 1 >= me.level) break;
             split(q);
             const auto first = static_cast<std::uint32_t>(octants_[q].first_child);

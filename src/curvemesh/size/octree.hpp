@@ -107,6 +107,7 @@ class SizeOctree final : public SizeField {
     std::uint32_t ix, iy, iz;   // lowest corner in units of the finest level
     std::int32_t first_child;   // -1 for a leaf; children are contiguous, index = bx + 2by + 4bz
     std::uint8_t level;
+    std::uint32_t parent;       // the root's is itself
   };
   struct Request {
     Vec3 x;
@@ -130,6 +131,10 @@ class SizeOctree final : public SizeField {
   Vec3 to_point(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) const;
   static Key key(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) { return ix | (iy << 21) | (iz << 42); }
   std::uint32_t find(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const;
+  // The leaf holding the point, found from octant `near` (up to the first
+  // ancestor holding it, then down): a few steps for a neighbour's point
+  // where find() walks down from the root.
+  std::uint32_t find_near(std::uint32_t near, std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const;
   std::uint32_t find_leaf_fast(const std::array<std::uint32_t, 3>& u) const;
   void split(std::uint32_t octant);
   std::vector<std::uint32_t> leaf_octants() const;
