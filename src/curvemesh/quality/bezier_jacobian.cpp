@@ -244,15 +244,17 @@ double compute_coefficients(const OrderTables& t, std::span<const Vec3> nodes, d
   const double node_scale = compute_control_points(t, nodes, control.data());
   std::array<std::array<Vec3, kMaxDerivs>, 3> deriv;
   double d_inf = 0;
-  double d_norm = 0;
+  double d_norm2 = 0;
   for (int j = 0; j < 3; ++j)
     for (int b = 0; b < t.num_derivs; ++b) {
       const Vec3 d = t.order * (control[static_cast<std::size_t>(t.plus[j][b])] -
                                 control[static_cast<std::size_t>(t.base[b])]);
       deriv[j][b] = d;
       d_inf = std::max(d_inf, d.cwiseAbs().maxCoeff());
-      d_norm = std::max(d_norm, d.norm());
+      d_norm2 = std::max(d_norm2, d.squaredNorm());
     }
+  // sqrt is monotone and correctly rounded: the largest norm, exactly.
+  const double d_norm = std::sqrt(d_norm2);
   // det J = sum_b D1_b B_b . (sum_g sum_d D2_g x D3_d B_g B_d): the inner
   // product expanded first (nd^2 cross products into the degree-2(p-1)
   // basis), then the dots (nd times that basis): 450 products for P3 where
