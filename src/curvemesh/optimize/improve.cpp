@@ -80,11 +80,60 @@ std::pair<double, double> worst_of(const mesh::TetMesh& m, std::span<const TetId
   for (TetId t : tets) take_worst(m, m.tet2verts[t], w);
   return w;
 }
-std::pair<double, double> worst_of(const mesh::TetMesh& m, std::span<const modify::NewTet> fill) {
-  std::pair<double, double> w{1, 1};
-  for (const auto& nt : fill) take_worst(m, nt.verts, w);
-  return w;
-}
+
+// Mean ratio and angle-aware quality (mean_ratio_and_shape) of would-be
+// tets, kept while one tet's reconnections are weighed: the two dynamic
+// programs of an edge's shell ask for the same tets, and the mesh does not
+// change in between. Keyed by the vertices in order (the order is the
+// orientation).
+class TetMemo {
+ public:
+  void clear() {
+    if (++stamp_ == 0) {
+      std::fill(slots_.begin(), slots_.end(), Slot{});
+      stamp_ = 1;
+    }
+    used_ = 0;
+  }
+  const std::pair<double, double>& get(const mesh::TetMesh& m, const std::array<VertId, 4>& v) {
+    if (2 * (used_ + 1) > slots_.size()) grow();
+    Slot& s = slots_[find(v)];
+    if (s.stamp != stamp_) {
+      s = {v, stamp_, mean_ratio_and_shape(m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]])};
+      ++used_;
+    }
+    return s.value;
+  }
+  static double mean_ratio(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void* memo) {
+    return const_cast<TetMemo*>(static_cast<const TetMemo*>(memo))->get(m, v).first;
+  }
+  static double shape(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void* memo) {
+    return const_cast<TetMemo*>(static_cast<const TetMemo*>(memo))->get(m, v).second;
+  }
+
+ private:
+  struct Slot {
+    std::array<VertId, 4> v{};
+    std::uint32_t stamp = 0;
+    std::pair<double, double> value;
+  };
+  std::size_t find(const std::array<VertId, 4>& v) const {
+    std::uint64_t h = (std::uint64_t(v[0]) << 32 | v[1]) * 0x9E3779B97F4A7C15ull ^ (std::uint64_t(v[2]) << 32 | v[3]);
+    h *= 0xC2B2AE3D27D4EB4Full;
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = (h >> 32) & mask;; i = (i + 1) & mask)
+      if (slots_[i].stamp != stamp_ || slots_[i].v == v) return i;
+  }
+  void grow() {
+    std::vector<Slot> old = std::move(slots_);
+    slots_.assign(std::max<std::size_t>(1024, 2 * old.size()), Slot{});
+    for (const Slot& s : old)
+      if (s.stamp == stamp_) slots_[find(s.v)] = s;
+  }
+  std::vector<Slot> slots_;
+  std::uint32_t stamp_ = 1;
+  std::size_t used_ = 0;
+};
 
 // The best reconnection of t: for each of its edges the ring triangulation
 // best for the angle-aware measure and the one best for the mean ratio, and
@@ -95,11 +144,15 @@ bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, Improve
   int kind = -1, local = 0;
   std::pair<double, double> best{-1, -1};  // (shape, mean ratio) after
   const auto tv = m.tet2verts[t];
+  thread_local TetMemo memo;
+  memo.clear();
   auto plan = [&](int k, int l) {
     const VertId a = tv[mesh::kTetEdges[l % 6][0]], b = tv[mesh::kTetEdges[l % 6][1]];
     switch (k) {
-      case 0: return plan_measured_edge_removal(ed, cav, a, b, t, angle_aware_measure, nullptr);
-      case 1: return modify::plan_edge_removal(ed, cav, a, b, t);
+      case 0: return plan_measured_edge_removal(ed, cav, a, b, t, TetMemo::shape, &memo);
+      // The same as modify::plan_edge_removal (the mean ratio is
+      // modify::tet_quality), with the memo's values.
+      case 1: return plan_measured_edge_removal(ed, cav, a, b, t, TetMemo::mean_ratio, &memo);
       default: return modify::plan_face_swap(ed, cav, t, l);
     }
   };
@@ -107,8 +160,15 @@ bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, Improve
     for (int l = 0; l < (k < 2 ? 6 : 4); ++l) {
       const modify::Plan p = plan(k, l);
       if (p.fill.empty() || !(p.after > 0)) continue;
-      const auto [mr_b, sh_b] = worst_of(m, cav.tets());
-      const auto [mr_a, sh_a] = worst_of(m, p.fill);
+      std::pair<double, double> worst_before{1, 1}, worst_after{1, 1};
+      const auto take = [&](const std::array<VertId, 4>& v, std::pair<double, double>& w) {
+        const auto& q = memo.get(m, v);
+        w = {std::min(w.first, q.first), std::min(w.second, q.second)};
+      };
+      for (TetId u : cav.tets()) take(m.tet2verts[u], worst_before);
+      for (const auto& nt : p.fill) take(nt.verts, worst_after);
+      const auto [mr_b, sh_b] = worst_before;
+      const auto [mr_a, sh_a] = worst_after;
       if (!is_progress(mr_b, sh_b, mr_a, sh_a) || std::pair{sh_a, mr_a} <= best) continue;
       best = {sh_a, mr_a};
       kind = k;
