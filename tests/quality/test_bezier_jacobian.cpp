@@ -334,6 +334,55 @@ TEST(BezierJacobian, CertifiedVerdictsAgreeWithDenseSampling) {
   }
 }
 
+// The near-straight bound never exceeds the ratio dense sampling sees (an
+// upper estimate of the true min/max), is close to 1 for slightly bent
+// tets, declines to answer for strongly bent ones, and is scale-free.
+TEST(BezierJacobian, NearStraightRatioIsALowerBound) {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int p : {2, 3, 4}) {
+    const auto idx = mesh::tet_node_indices(p);
+    int answered = 0, slight = 0;
+    for (double magnitude : {0.002, 0.02, 0.06, 0.15, 0.4})
+      for (int trial = 0; trial < 30; ++trial) {
+        const auto v = random_good_tet(rng);
+        auto nodes = linear_nodes(p, v);
+        for (std::size_t n = 0; n < nodes.size(); ++n)
+          if (*std::max_element(idx[n].begin(), idx[n].end()) < p)
+            nodes[n] += magnitude * Vec3(u(rng), u(rng), u(rng));
+        const NearStraightBounds bounds = near_straight_bounds(p, nodes);
+        const double bound = bounds.ratio;
+        if (bound < 0) continue;
+        ++answered;
+        const Samples smp = sample_detj(p, nodes, p == 4 ? 12 : 16, 200, rng);
+        ASSERT_GT(smp.min, 0) << "p " << p << " magnitude " << magnitude;
+        EXPECT_LE(bound, smp.min / smp.max) << "p " << p << " magnitude " << magnitude;
+        // The mean of det J is the mean of its Bezier coefficients.
+        const auto coefs = jacobian_bezier_coefficients(p, nodes);
+        double mean = 0;
+        for (double c : coefs) mean += c / static_cast<double>(coefs.size());
+        EXPECT_LE(bounds.mean_ratio, smp.min / mean) << "p " << p << " magnitude " << magnitude;
+        EXPECT_GE(bounds.mean_ratio, bound) << "p " << p;
+        slight += magnitude <= 0.002 && bound > 0.8;
+        // The same after a similarity far from the origin.
+        const auto moved = similar(nodes, random_rotation(rng), 1e-3, Vec3(1e3, -2e3, 5e2));
+        EXPECT_NEAR(near_straight_bounds(p, moved).ratio, bound, 1e-6) << "p " << p;
+      }
+    // Every node moved at random by 0.2% of the size: curving bends far more
+    // smoothly, but even so orders 2 and 3 get a useful bound (order 4, which
+    // curving does not use, is checked for the bound only).
+    if (p <= 3) {
+      EXPECT_EQ(slight, 30) << "p " << p;
+    }
+    EXPECT_GT(answered, 0) << "p " << p;
+  }
+  // Straight: the ratio is 1 up to the rounding margin; inverted: no answer.
+  const auto straight = linear_nodes(3, kUnit);
+  EXPECT_GT(near_straight_bounds(3, straight).ratio, 1 - 1e-9);
+  const std::array<Vec3, 4> flipped{kUnit[1], kUnit[0], kUnit[2], kUnit[3]};
+  EXPECT_EQ(near_straight_bounds(3, linear_nodes(3, flipped)).ratio, -1);
+}
+
 TEST(BezierJacobian, OrderFourAgainstSampling) {
   std::mt19937 rng(4);
   int valid = 0, invalid = 0, undetermined = 0;

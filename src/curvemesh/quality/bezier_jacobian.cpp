@@ -59,6 +59,7 @@ struct OrderTables {
   };
   std::vector<ProductTerm> pairs;
   std::vector<ProductTerm> dots;
+  std::array<int, 4> vertex_rank{};  // control point of each vertex (p e_k)
   int num_pair_sums = 0;  // Bernstein basis of degree 2(p-1)
   int pair_terms = 0;     // most cross products summed into one pair sum
   int dot_terms = 0;      // most dots summed into one coefficient
@@ -136,6 +137,11 @@ OrderTables build_order_tables(int p) {
     t.lag2bez_norm = std::max(t.lag2bez_norm, row);
   }
 
+  for (int k = 0; k < 4; ++k) {
+    MultiIndex corner{0, 0, 0, 0};
+    corner[k] = p;
+    t.vertex_rank[static_cast<std::size_t>(k)] = bernstein_rank(corner);
+  }
   const auto derivs = bernstein_indices(p - 1);
   for (const MultiIndex& b : derivs) {
     MultiIndex at0 = b;
@@ -590,6 +596,59 @@ ValidityReport certify_jacobian(int order, std::span<const Vec3> nodes,
   rep.where_entity = classify_bary(rep.where, 0);
   rep.scaled_jacobian_lower = scaled_lower(rep);
   return rep;
+}
+
+NearStraightBounds near_straight_bounds(int order, std::span<const Vec3> nodes) {
+  check_input(order, nodes);
+  NearStraightBounds out;
+  if (order < 2) return out;
+  const OrderTables& t = order_tables(order);
+  std::array<Vec3, kMaxNodes> control;
+  const double node_scale = compute_control_points(t, nodes, control.data());
+  const auto vertex = [&](int k) { return control[static_cast<std::size_t>(t.vertex_rank[static_cast<std::size_t>(k)])]; };
+  Mat3 j0;
+  for (int j = 0; j < 3; ++j) j0.col(j) = vertex(j + 1) - vertex(0);
+  const double det = j0.determinant();
+  const double size = j0.squaredNorm();
+  // A straight tet this flat has a determinant whose relative rounding is
+  // no longer negligible: the full certification decides.
+  if (!(det > 1e-6 * size * std::sqrt(size))) return out;
+  const Mat3 inverse = j0.inverse();
+  // J(xi) = J0 (I + A(xi)) with A = sum_b A_b B_b(xi), A_b = J0^-1 (D_b - J0)
+  // for the derivative control points D_b (columns D_{j,b}). det(I + A) =
+  // 1 + tr A + c2(A) + det A: tr A lies within the A_b's traces (Bernstein
+  // weights are a convex combination), |A|_F under the largest |A_b|_F = s,
+  // and |c2(A)| <= |A|_F^2, |det A| <= |A|_F^3 / sqrt(27).
+  double t_lo = INFINITY, t_hi = -INFINITY, t_sum = 0, s2 = 0;
+  for (int b = 0; b < t.num_derivs; ++b) {
+    Mat3 d;
+    for (int j = 0; j < 3; ++j)
+      d.col(j) = order * (control[static_cast<std::size_t>(t.plus[j][b])] - control[static_cast<std::size_t>(t.base[b])]);
+    const Mat3 a = inverse * (d - j0);
+    t_lo = std::min(t_lo, a.trace());
+    t_hi = std::max(t_hi, a.trace());
+    t_sum += a.trace();
+    s2 = std::max(s2, a.squaredNorm());
+  }
+  const double t_mean = t_sum / t.num_derivs;
+  // Rounding: the derivative control points are within e_d per coordinate
+  // (as in compute_coefficients), J0's columns within a few units of the
+  // translated nodes; through J0^-1 that moves every A_b by at most
+  // `slack` (Frobenius), its trace by sqrt(3) times that. The products
+  // here add relative errors far below the 1e-8 kept.
+  const double e_c = gamma(t.num_nodes + 4) * t.lag2bez_norm * node_scale;
+  const double per_coordinate = 2 * order * e_c + 8 * kUnitRoundoff * node_scale;
+  const double slack = inverse.norm() * 3 * per_coordinate * 1.01 + 1e-8 * std::sqrt(s2);
+  const double s = std::sqrt(s2) * (1 + 1e-8) + slack;
+  const double higher = s * s + s * s * s / std::sqrt(27.0);
+  const double pad = std::sqrt(3.0) * slack;
+  const double lo = 1 + t_lo - pad - std::abs(t_lo) * 1e-8 - higher;
+  const double hi = 1 + t_hi + pad + std::abs(t_hi) * 1e-8 + higher;
+  const double mean = 1 + t_mean + pad + std::abs(t_mean) * 1e-8 + higher;
+  if (!(lo > 0)) return out;
+  out.ratio = lo / hi * (1 - 1e-12);
+  out.mean_ratio = lo / mean * (1 - 1e-12);
+  return out;
 }
 
 ValidityReport certify_tet(const mesh::TetMesh& m, TetId t, const ValidityOptions& options) {

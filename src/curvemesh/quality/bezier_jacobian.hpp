@@ -127,6 +127,24 @@ std::vector<Vec3> geometry_control_points(int order, std::span<const Vec3> nodes
 ValidityReport certify_jacobian(int order, std::span<const Vec3> nodes,
                                 const ValidityOptions& options = {}, std::span<double> coefficients = {});
 
+/// Certified lower bounds of min det J / max det J and of min det J / mean
+/// det J over the element, from how its derivative control points D_b
+/// depart from the straight tet's J0 (orders 2 to kMaxBezierOrder): J(xi) =
+/// J0 (I + A(xi)) with A a Bernstein combination of A_b = J0^-1 (D_b - J0),
+/// and det(I + A) = 1 + tr A + (terms of second and third order): the
+/// first-order term is bounded by the A_b's traces (its mean is theirs:
+/// Bernstein polynomials of one degree have one integral), the others by
+/// the A_b's largest Frobenius norm. About a sixth of a certification's cost
+/// and tight for the boundary tets that curving bends a little. Rounding is
+/// accounted for with a margin. Both are -1 where it cannot tell (the lower
+/// bound of det J is not positive, or the straight tet is too flat to bound
+/// reliably). Preconditions as for certify_jacobian.
+struct NearStraightBounds {
+  double ratio = -1;       ///< of min det J / max det J (the scaled Jacobian)
+  double mean_ratio = -1;  ///< of min det J / mean det J (a lower bound of I, eq. 3.5)
+};
+NearStraightBounds near_straight_bounds(int order, std::span<const Vec3> nodes);
+
 /// certify_jacobian on tet t of m, at the mesh's order (mesh::gather_tet_nodes).
 ValidityReport certify_tet(const mesh::TetMesh& m, TetId t, const ValidityOptions& options = {});
 
