@@ -357,13 +357,7 @@ int run_optimize(const OptimizeCliOptions& o) {
     if (!metric) throw InputError("--sol-out", -1, -1, "needs a size specification (--sol, --size-expr, --hmin/--hmax or --aniso)");
     io::SolField sol;
     sol.type = metric->anisotropic() ? io::SolField::Type::kTensor : io::SolField::Type::kScalar;
-    for (VertId v = 0; v < metric->size(); ++v) {
-      const auto& t = metric->metric(v);
-      if (metric->anisotropic())
-        sol.values.insert(sol.values.end(), {t(0, 0), t(0, 1), t(1, 1), t(0, 2), t(1, 2), t(2, 2)});
-      else
-        sol.values.push_back(metric->size_at(v));
-    }
+    sol.values = optimize::metric_field_values(*metric);
     io::write_sol(sol, o.sol_out, io::format_from_path(o.sol_out) == io::FileFormat::kSolBinary);
   }
   const double write_s = step.seconds();

@@ -185,6 +185,20 @@ MetricField metric_field_from_values(std::span<const double> values, int compone
   return MetricField::from_tensors(std::move(ms));
 }
 
+std::vector<double> metric_field_values(const MetricField& field) {
+  std::vector<double> out;
+  out.reserve(field.size() * (field.anisotropic() ? 6 : 1));
+  for (VertId v = 0; v < field.size(); ++v) {
+    if (!field.anisotropic()) {
+      out.push_back(field.size_at(v));
+      continue;
+    }
+    const auto& t = field.metric(v);
+    out.insert(out.end(), {t(0, 0), t(0, 1), t(1, 1), t(0, 2), t(1, 2), t(2, 2)});
+  }
+  return out;
+}
+
 MetricField metric_field_from_mesh_sizes(const mesh::TetMesh& m) {
   return MetricField::from_sizes(mean_edge_lengths(m));
 }

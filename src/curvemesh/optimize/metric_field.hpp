@@ -81,6 +81,9 @@ double edge_metric_length(const Vec3& p, const Vec3& q, const size::Metric& mp, 
 /// count is not components · num_verts ("N values for M vertices") or a value
 /// is unusable.
 MetricField metric_field_from_values(std::span<const double> values, int components, std::size_t num_verts);
+/// Its inverse: per vertex the size (isotropic field) or the tensor's six
+/// entries in MMG's order (m11, m12, m22, m13, m23, m33), as a .sol holds them.
+std::vector<double> metric_field_values(const MetricField& field);
 
 /// The mesh's own sizes: at each vertex, the mean length of its edges. What
 /// --hmin/--hmax clamp when no other size is given (as MMG does). Vertices
