@@ -68,8 +68,8 @@ const std::vector<Builtin>& builtins() {
        {{"scale", 1}}},
       {"blocks",
        "two regions sharing the face x = dx1: boxes [0,dx1] x [0,dy] x [0,dz] and "
-       "[dx1,dx1+dx2] x [0,dy] x [0,dz]",
-       {{"dx1", 1}, {"dx2", 1}, {"dy", 1}, {"dz", 1}}},
+       "[dx1-o,dx1+dx2] x [0,dy] x [0,dz] (o: an overlap, as of parts that interpenetrate by a hair)",
+       {{"dx1", 1}, {"dx2", 1}, {"dy", 1}, {"dz", 1}, {"o", 0}}},
       {"inclusion",
        "two regions: a sphere of radius r inside the cube [-s/2,s/2]^3, and the rest of the cube",
        {{"s", 2}, {"r", 0.5}}},
@@ -262,8 +262,10 @@ ReadShape make_builtin(const std::string& spec) {
       out.shape = BRepPrimAPI_MakeCone(r1, r2, positive("h")).Shape();
     } else if (name == "blocks") {
       const double dx1 = positive("dx1"), dx2 = positive("dx2"), dy = positive("dy"), dz = positive("dz");
+      const double overlap = p.at("o");
+      require(overlap >= 0 && overlap < std::min(dx1, dx2), spec, "the overlap o must be in [0, min(dx1, dx2))");
       out.shape = make_compound({BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), dx1, dy, dz).Shape(),
-                                 BRepPrimAPI_MakeBox(gp_Pnt(dx1, 0, 0), dx2, dy, dz).Shape()});
+                                 BRepPrimAPI_MakeBox(gp_Pnt(dx1 - overlap, 0, 0), dx2 + overlap, dy, dz).Shape()});
     } else if (name == "inclusion") {
       const double side = positive("s"), r = positive("r");
       require(2 * r < side, spec, "the sphere (2r) must fit inside the cube (s)");

@@ -1,6 +1,7 @@
 // From the shape as read to a compound of closed, outward-oriented, mutually
 // conformal solids: healing, sewing, solid making and the general fuse.
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <BOPAlgo_Builder.hxx>
@@ -9,7 +10,9 @@
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepClass3d_SolidClassifier.hxx>
 #include <BRep_Builder.hxx>
+#include <BRepBndLib.hxx>
 #include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
 #include <Message_Report.hxx>
 #include <Precision.hxx>
 #include <ShapeFix_Shape.hxx>
@@ -80,6 +83,21 @@ TopoDS_Shape heal(const ReadShape& read, const LoadOptions& options, double tol)
   fixer.SetMaxTolerance(std::max(tol * 10, 1e-3));
   fixer.Perform();
   return fixer.Shape();
+}
+
+// Solids of an assembly that nearly touch, or overlap by a hair, are fused
+// as if they met exactly when their gap or overlap is under this fraction
+// of the model's diagonal. Fused exactly they leave strip faces a millionth
+// of the model wide (a cylinder band 3e-6 high on a sink 130 across), far
+// below any mesh size there, whose needle triangles no Steiner point can
+// recover. Gaps this small are beneath the chord error of any mesh of the
+// model.
+constexpr double kFuseFuzz = 1e-6;
+
+double diagonal_of(const TopoDS_Shape& shape) {
+  Bnd_Box box;
+  BRepBndLib::Add(shape, box);
+  return box.IsVoid() ? 0 : std::sqrt(box.SquareExtent());
 }
 
 std::vector<TopoDS_Solid> sew_into_solids(const TopoDS_Shape& shape, const LoadOptions& options,
@@ -169,6 +187,7 @@ TopoDS_Shape make_conformal_solids(const ReadShape& read, const LoadOptions& opt
     BOPAlgo_Builder fuse;
     for (const TopoDS_Solid& s : solids) fuse.AddArgument(s);
     fuse.SetRunParallel(false);  // deterministic and polite to the caller's threads
+    fuse.SetFuzzyValue(kFuseFuzz * diagonal_of(shape));
     fuse.Perform();
     if (fuse.HasErrors()) {
       Standard_SStream report;

@@ -340,6 +340,9 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
   // Stuck: a pass that changed nothing, or left the worst tet as it was.
   bool stuck = false;
   double last_worst = -1;
+  constexpr std::size_t kWindow = 3;
+  constexpr double kStall = 0.01;
+  std::vector<std::pair<double, std::size_t>> history;  // per pass: the worst badness, the tets to work on
   for (st.passes = 0; st.passes < o.passes; ++st.passes) {
     if (st.passes == 0) {
       candidates.resize(m.tet2verts.size());
@@ -372,6 +375,18 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
     std::sort(bad.begin(), bad.end());
     if (!(bad.front().first > last_worst + 1e-6) && st.passes > 0) stuck = true;
     last_worst = bad.front().first;
+    // Converged: over the last kWindow passes neither the worst tet rose by
+    // kStall (relative) nor did the tets to work on become kStall fewer.
+    // Where the mesh cannot become good (a layer of slivers a thousandth
+    // thick between model faces) passes would otherwise go on trading tiny
+    // gains between neighbours, seconds each, to the pass limit.
+    history.emplace_back(bad.front().first, bad.size());
+    if (stuck && history.size() > kWindow) {
+      const auto [worst_then, count_then] = history[history.size() - 1 - kWindow];
+      if (bad.front().first <= worst_then + kStall * std::abs(worst_then) &&
+          static_cast<double>(bad.size()) >= (1 - kStall) * static_cast<double>(count_then))
+        break;
+    }
     std::size_t changes = 0;
     for (const auto& [q0, t] : bad) {
       if (ed.is_dead(t) || !needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o)) continue;
