@@ -242,7 +242,6 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
   // `keep` holds what the first pass computed: a check that reuses it then
   // makes the same full certifications below and gives what a fresh one
   // gives (a few tets; the first pass is the cost).
-  const auto update = [&](TetId t, const ElementCheck& c) { checks[t] = c; };
   // Certified in full, lowest bound first, the tets whose bound is under
   // the least exact value found so far (`exact` tells a tet already has
   // it, `bound` reads the value or its lower bound).
@@ -258,7 +257,7 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
     std::sort(open.begin(), open.end());
     for (const auto& [value, t] : open) {
       if (value >= least) break;
-      update(t, check_element(order, mesh::tet_nodes(m, m.tet2verts[t]).view(), acceptance, exact_measure));
+      checks[t] = check_element(order, mesh::tet_nodes(m, m.tet2verts[t]).view(), acceptance, exact_measure);
       least = std::min(least, bound(checks[t]));
     }
   };

@@ -12,10 +12,7 @@
 namespace cm::optimize {
 
 double angle_aware_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return -1;
-  constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
-  const double angle = quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral;
-  return std::max(std::min(quality::tet_mean_ratio(a, b, c, d), angle), 0.0);
+  return mean_ratio_and_shape(a, b, c, d).second;
 }
 
 std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {

@@ -146,14 +146,17 @@ Vec3 SizeOctree::to_point(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) 
   return origin_ + unit * Vec3(double(ix), double(iy), double(iz));
 }
 
-std::uint32_t SizeOctree::find(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const {
-  std::uint32_t o = 0;
+std::uint32_t SizeOctree::descend(std::uint32_t o, std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const {
   while (octants_[o].first_child >= 0) {
     const int bit = opt_.max_depth - octants_[o].level - 1;
     const std::uint32_t child = ((ix >> bit) & 1u) | (((iy >> bit) & 1u) << 1) | (((iz >> bit) & 1u) << 2);
     o = static_cast<std::uint32_t>(octants_[o].first_child) + child;
   }
   return o;
+}
+
+std::uint32_t SizeOctree::find(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const {
+  return descend(0, ix, iy, iz);
 }
 
 std::uint32_t SizeOctree::find_near(std::uint32_t o, std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const {
@@ -163,12 +166,7 @@ std::uint32_t SizeOctree::find_near(std::uint32_t o, std::uint32_t ix, std::uint
     if (q.level == 0 || (ix - q.ix < s && iy - q.iy < s && iz - q.iz < s)) break;  // unsigned: below is huge
     o = q.parent;
   }
-  while (octants_[o].first_child >= 0) {
-    const int bit = opt_.max_depth - octants_[o].level - 1;
-    const std::uint32_t child = ((ix >> bit) & 1u) | (((iy >> bit) & 1u) << 1) | (((iz >> bit) & 1u) << 2);
-    o = static_cast<std::uint32_t>(octants_[o].first_child) + child;
-  }
-  return o;
+  return descend(o, ix, iy, iz);
 }
 
 void SizeOctree::split(std::uint32_t o) {
@@ -350,13 +348,7 @@ void SizeOctree::build_query_grid() {
 std::uint32_t SizeOctree::find_leaf_fast(const std::array<std::uint32_t, 3>& u) const {
   const int shift = opt_.max_depth - grid_level_;
   const std::size_t n = std::size_t{1} << grid_level_;
-  std::uint32_t o = grid_[((u[2] >> shift) * n + (u[1] >> shift)) * n + (u[0] >> shift)];
-  while (octants_[o].first_child >= 0) {
-    const int bit = opt_.max_depth - octants_[o].level - 1;
-    const std::uint32_t child = ((u[0] >> bit) & 1u) | (((u[1] >> bit) & 1u) << 1) | (((u[2] >> bit) & 1u) << 2);
-    o = static_cast<std::uint32_t>(octants_[o].first_child) + child;
-  }
-  return o;
+  return descend(grid_[((u[2] >> shift) * n + (u[1] >> shift)) * n + (u[0] >> shift)], u[0], u[1], u[2]);
 }
 
 double SizeOctree::size(const Vec3& x, const SizeHint&) const {

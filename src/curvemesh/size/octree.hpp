@@ -130,6 +130,8 @@ class SizeOctree final : public SizeField {
   std::array<std::uint32_t, 3> to_units(const Vec3& x) const;
   Vec3 to_point(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) const;
   static Key key(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz) { return ix | (iy << 21) | (iz << 42); }
+  // The leaf under octant o holding the point.
+  std::uint32_t descend(std::uint32_t o, std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const;
   std::uint32_t find(std::uint32_t ix, std::uint32_t iy, std::uint32_t iz) const;
   // The leaf holding the point, found from octant `near` (up to the first
   // ancestor holding it, then down): a few steps for a neighbour's point
