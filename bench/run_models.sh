@@ -2,7 +2,7 @@
 # Volume-meshes every shared model at the default size, a coarse hmax
 # (bounding-box diagonal / 8) and a fine one (diagonal / 35), and prints one
 # line per run: tets, time (total, and of the quality optimization),
-# validity, Steiner points, quality. The issue's
+# validity, Steiner points and volume flips of recovery, quality. The issue's
 # "every model, default + coarse + fine" check, comparable run to run.
 #
 # usage: bench/run_models.sh [BUILD_DIR] [MODELS_DIR] [extra curvemesh mesh options...]
@@ -12,7 +12,7 @@ models=${2:-../shared/models}
 shift 2 2>/dev/null || shift $#
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-printf '%-40s %-8s %10s %9s %8s %8s %6s %8s %8s %8s %8s\n' model size hmax tets seconds opt_s valid steiner minq meanq mindih
+printf '%-40s %-8s %10s %9s %8s %8s %6s %8s %6s %8s %8s %8s\n' model size hmax tets seconds opt_s valid steiner vflips minq meanq mindih
 fail=0
 for f in "$models"/*.st[ep]* "$models"/*.brep; do
   [ -f "$f" ] || continue
@@ -34,6 +34,7 @@ r, q = d["recovery"], d["quality"]
 print(f'{sys.argv[2]:40s} {sys.argv[3]:8s} {d["hmax"]:10.4g} {d["counts"]["tets"]:9d} {d["seconds"]["total"]:8.2f} '
       f'{d["seconds"]["optimize"]:8.2f} '
       f'{str(d["check"]["valid"]):>6s} {r["steiner_on_model_edges"] + r["steiner_on_model_faces"]:8d} '
+      f'{r["volume_flips"]:6d} '
       f'{q["mean_ratio_min"]:8.3f} {q["mean_ratio_mean"]:8.3f} {q["min_dihedral_deg"]:8.2f}')
 EOF
     else

@@ -209,6 +209,9 @@ int run_volume(const MeshCliOptions& o) {
                    {"steiner_on_model_edges", st.recovery.steiner_on_edges},
                    {"steiner_on_model_faces", st.recovery.steiner_on_faces},
                    {"surface_flips", st.recovery.surface_flips},
+                   {"volume_flips", st.recovery.volume_flips},
+                   {"edges_by_volume_flips", st.recovery.edges_by_volume_flips},
+                   {"triangles_by_volume_flips", st.recovery.triangles_by_volume_flips},
                    {"rounds", st.recovery.rounds},
                    {"region_conflicts", st.region_conflicts}};
   j["check"] = {{"valid", ok},
@@ -259,9 +262,10 @@ int run_volume(const MeshCliOptions& o) {
     fmt::print("mesh: {} vertices, {} tets, {} boundary triangles; {} interior points ({} refused)\n",
                m.num_verts(), nt, m.tris.size(), st.interior_points, st.refused_points);
     fmt::print("recovery: {} missing edges, {} missing triangles; {} Steiner points ({} on model edges, {} on model "
-               "faces), {} surface flips, in {} rounds\n",
+               "faces), {} surface flips, {} volume flips ({} edges, {} triangles recovered by them), in {} rounds\n",
                st.recovery.missing_edges_initial, st.recovery.missing_triangles_initial, steiner,
                st.recovery.steiner_on_edges, st.recovery.steiner_on_faces, st.recovery.surface_flips,
+               st.recovery.volume_flips, st.recovery.edges_by_volume_flips, st.recovery.triangles_by_volume_flips,
                st.recovery.rounds);
     if (!o.no_optimize)
       fmt::print("optimization: {}; tets with mean ratio < 0.3: {} -> {}; min {:.3f} -> {:.3f}; min dihedral {:.2f} -> "

@@ -10,6 +10,7 @@ pkgs=(
   libeigen3-dev libtbb-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
   pybind11-dev libgtest-dev libgmock-dev libbenchmark-dev libgmp-dev
   gmsh python3-gmsh
+  occt-misc
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "curvemesh/core/error.hpp"
+#include "curvemesh/generate/flip_recovery.hpp"
 #include "curvemesh/generate/surface_intersection.hpp"
 #include "curvemesh/mesh/adjacency.hpp"
 
@@ -294,6 +295,25 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     modify::MeshEditor& ed;
     ~HookReset() { ed.set_hook({}); }
   } hook_reset{ed};
+  // Flips never remove an edge of the surface mesh (present or not), hence
+  // never a recovered edge or triangle.
+  FlipRecovery flips(ed, [&surf](VertId a, VertId b) { return surf.exists(a, b); });
+  // A failed attempt may have flipped too: any flip ends Delaunay insertion's
+  // assumption that cavities are star-shaped.
+  auto volume_flips_now = [&] { return st.rounds >= o.flips_from_round; };
+  auto flipped_in = [&](bool ok) {
+    if (flips.stats().face_swaps + flips.stats().edge_removals != 0) dt.set_non_delaunay();
+    return ok;
+  };
+  struct FlipStats {
+    RecoveryStats& st;
+    FlipRecovery& flips;
+    ~FlipStats() {
+      st.volume_flips = flips.stats().face_swaps + flips.stats().edge_removals;
+      st.edges_by_volume_flips = flips.stats().edges_recovered;
+      st.triangles_by_volume_flips = flips.stats().triangles_recovered;
+    }
+  } flip_stats{st, flips};
   for (st.rounds = 0;; ++st.rounds) {
     to_split.clear();
     std::size_t missing_tris = 0;
@@ -351,6 +371,7 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
         for (VertId x : v) dirty[x] = 1;
         continue;
       }
+      if (volume_flips_now() && flipped_in(flips.recover_triangle(v[0], v[1], v[2]))) continue;
       last_face = t.face_tag;
       int longest = 0;
       double best = -1;
@@ -379,14 +400,15 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     std::size_t flipped = 0, index = 0;
     std::erase_if(to_split, [&](const std::pair<VertId, VertId>& e) {
       const auto [a, b] = e;
-      if (index++ >= missing_edges || !surf.exists(a, b) || flip_made.count(edge_key(a, b))) return false;
+      if (index++ >= missing_edges || !surf.exists(a, b)) return false;
+      if (flip_made.count(edge_key(a, b))) return volume_flips_now() && flipped_in(flips.recover_edge(a, b));
       const auto it = surf.edges().find(edge_key(a, b));
       std::array<VertId, 4> quad{a, b, kNone, kNone};
       if (it != surf.edges().end() && it->second.size() == 2)
         for (int k = 0; k < 2; ++k)
           for (VertId v : m.tris[it->second[k]].verts)
             if (v != a && v != b) quad[2 + k] = v;
-      if (!surf.flip_to_mesh(a, b, ball)) return false;
+      if (!surf.flip_to_mesh(a, b, ball)) return volume_flips_now() && flipped_in(flips.recover_edge(a, b));
       flip_made.insert(edge_key(quad[2], quad[3]));
       if (dirty.size() < m.coords.size()) dirty.resize(m.coords.size(), 0);
       for (VertId v : quad) dirty[v] = 1;

@@ -7,14 +7,23 @@
 // feature) have their longest edges split on the model until none cross:
 // nothing else could recover them.
 //
-// Method: conforming recovery by Steiner points on the model. A missing mesh
+// Then, before any Steiner point, a missing edge or triangle is recovered by
+// flips of the tetrahedralization when they can (FlipRecovery: no vertex added, no
+// boundary edge removed). Two faces closer than the mesh size — a thin
+// slab, parts of an assembly nearly touching — need them: Steiner points
+// alone must refine both faces to the scale of their gap, and the splits
+// cascade. After a flip the mesh is no longer Delaunay, and Steiner points
+// go in by star-correcting insertion (Delaunay3d::set_non_delaunay).
+//
+// Otherwise: conforming recovery by Steiner points on the model. A missing mesh
 // edge is split at the point of its model entity closest to its midpoint — on
 // the model edge (parameter kept) when it is a model-edge segment, else on the
 // model face ((u, v) kept) — the triangles around it are split too, and the
 // point is inserted in the Delaunay mesh. A missing edge inside one model face
 // is first flipped in the surface mesh when the other diagonal of its two
-// triangles is a mesh edge (the face's points can be triangulated either way). A missing triangle whose edges are
-// all present has its longest edge split. Splits shrink the local spacing
+// triangles is a mesh edge (the face's points can be triangulated either
+// way), before the volume flips. A missing triangle whose edges are all
+// present has its longest edge split. Splits shrink the local spacing
 // until every surface simplex is Delaunay; since points are only added on the
 // model, geometric similarity holds throughout. The loop is bounded: if it has
 // not converged after max_rounds or max_steiner points it throws
@@ -30,14 +39,24 @@ struct RecoveryOptions {
   int max_rounds = 200;
   /// Steiner points allowed, as a multiple of the initial surface vertices.
   double max_steiner_factor = 4.0;
+  /// First round in which missing simplices are flipped into the
+  /// tetrahedralization (before that, only split; a large value gives
+  /// conforming recovery by Steiner points alone). Flipped-in simplices keep
+  /// the surface mesh as it is, which is what recovers faces closer than
+  /// the mesh size, but can leave flatter tets at the boundary than splits
+  /// would: on the shared models the minimum dihedral angle is the same or
+  /// better with flips from round 0 on all but one.
+  int flips_from_round = 0;
 };
 
 struct RecoveryStats {
   std::size_t missing_edges_initial = 0, missing_triangles_initial = 0;
   std::size_t steiner_on_edges = 0, steiner_on_faces = 0;
-  std::size_t surface_flips = 0;
+  std::size_t surface_flips = 0;  ///< face-interior surface edges flipped to an edge of the tetrahedralization
   std::size_t crossing_pairs_initial = 0;  ///< pairs of surface triangles crossing each other before recovery
-  std::size_t crossing_splits = 0;         ///< Steiner points (counted above too) that removed crossings  ///< face-interior surface edges flipped to an edge of the tetrahedralization
+  std::size_t crossing_splits = 0;         ///< Steiner points (counted above too) that removed crossings
+  std::size_t volume_flips = 0;            ///< 2-3 swaps and edge removals made to recover simplices
+  std::size_t edges_by_volume_flips = 0, triangles_by_volume_flips = 0;  ///< simplices those flips recovered
   int rounds = 0;
 };
 

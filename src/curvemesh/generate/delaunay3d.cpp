@@ -1,6 +1,7 @@
 #include "curvemesh/generate/delaunay3d.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <stdexcept>
 
 #include "curvemesh/core/error.hpp"
@@ -199,6 +200,15 @@ Delaunay3d::Result Delaunay3d::insert(VertId v, TetId hint) {
       res.refusal = r;
       return res;
     }
+  } else if (non_delaunay_) {
+    if (modify::check_star(m, cavity_, v) != modify::Refusal::kNone) {
+      if (!shrink_to_star(v, t0)) {
+        res.refusal = modify::Refusal::kNotStarShaped;
+        return res;
+      }
+      ++shrunk_;
+      res.cavity_size = cavity_.tets().size();
+    }
   } else {
     // Unconstrained cavities are star-shaped by construction (see header);
     // checking costs one orient3d per boundary face, so debug builds only.
@@ -207,6 +217,44 @@ Delaunay3d::Result Delaunay3d::insert(VertId v, TetId hint) {
   const auto created = modify::fill_star(editor_, cavity_, v);
   last_ = created.front();
   return res;
+}
+
+bool Delaunay3d::shrink_to_star(VertId v, TetId t0) {
+  auto& m = editor_.mesh();
+  const double* x = m.coords[v].data();
+  auto contains_v = [&](TetId t) {
+    const auto& tv = m.tet2verts[t];
+    for (const auto& fv : mesh::kFaceVerts)
+      if (predicates::orient3d(m.coords[tv[fv[0]]].data(), m.coords[tv[fv[1]]].data(), m.coords[tv[fv[2]]].data(),
+                               x) > 0)
+        return false;
+    return true;
+  };
+  keep_.assign(cavity_.tets().begin(), cavity_.tets().end());
+  std::sort(keep_.begin(), keep_.end());
+  // Each pass drops every tet behind a face that hides v, then regrows from
+  // t0 through what is left (dropping may disconnect the cavity; a star
+  // fill needs it connected). The cavity only shrinks, and t0 always stays.
+  for (;;) {
+    std::vector<TetId> drop;
+    for (const modify::CavityFace& f : cavity_.boundary()) {
+      if (f.verts[0] == v || f.verts[1] == v || f.verts[2] == v) continue;
+      if (predicates::orient3d(m.coords[f.verts[0]].data(), m.coords[f.verts[1]].data(), m.coords[f.verts[2]].data(),
+                               x) < 0)
+        continue;
+      const TetId t = mesh::face_tet(f.inside);
+      if (contains_v(t)) return false;
+      drop.push_back(t);
+    }
+    if (drop.empty()) return true;
+    std::sort(drop.begin(), drop.end());
+    std::vector<TetId> left;
+    std::set_difference(keep_.begin(), keep_.end(), drop.begin(), drop.end(), std::back_inserter(left));
+    keep_.swap(left);
+    cavity_.reset(editor_);
+    cavity_.grow(editor_, t0,
+                 [&](TetId n) { return std::binary_search(keep_.begin(), keep_.end(), n); }, false);
+  }
 }
 
 std::vector<VertId> Delaunay3d::insert_all(std::span<const VertId> verts) {

@@ -70,6 +70,16 @@ class Delaunay3d {
   bool is_protected(const std::array<VertId, 3>& face) const;
   std::size_t protected_faces() const { return protected_count_; }
 
+  /// Tells insert() that the mesh was changed by other operations than
+  /// insertion (flips of boundary recovery) and may no longer be Delaunay.
+  /// A cavity of tets whose circumspheres hold the point may then not be
+  /// star-shaped from it; unconstrained insertion shrinks it until it is
+  /// (dropping tets that hide the point, never one containing it) instead
+  /// of assuming it. Cannot be undone.
+  void set_non_delaunay() { non_delaunay_ = true; }
+  /// Insertions whose cavity had to be shrunk (see set_non_delaunay).
+  std::size_t shrunk_cavities() const { return shrunk_; }
+
   /// Tet created by the last successful insertion (a good walk start).
   TetId last_tet() const { return last_; }
   std::size_t exact_walk_steps() const { return walk_steps_; }
@@ -88,6 +98,12 @@ class Delaunay3d {
   const VertId* rank_ = nullptr;
   std::size_t walk_steps_ = 0;
   std::size_t protected_count_ = 0;
+  bool non_delaunay_ = false;
+  std::size_t shrunk_ = 0;
+  std::vector<TetId> keep_;
+  /// Shrinks cavity_ (grown from t0) until it is star-shaped from v;
+  /// false if a tet containing v hides it.
+  bool shrink_to_star(VertId v, TetId t0);
   mutable std::vector<TetId> ball_;
 };
 

@@ -11,7 +11,12 @@
 
 namespace cm::modify {
 
-Plan plan_edge_removal(MeshEditor& ed, Cavity& cav, VertId a, VertId b, TetId start) {
+namespace {
+
+// Edge removal with `value(tri, tets, floor)` rating a ring triangle (ring
+// vertices) by the two tets it makes; see triangulate_ring for the floor.
+template <class Value>
+Plan plan_ring_fill(MeshEditor& ed, Cavity& cav, VertId a, VertId b, TetId start, Value&& value) {
   const auto& m = ed.mesh();
   Plan plan;
   const mesh::Shell shell = mesh::collect_shell(m, a, b, start);
@@ -66,9 +71,8 @@ Plan plan_edge_removal(MeshEditor& ed, Cavity& cav, VertId a, VertId b, TetId st
                       : std::array<std::array<VertId, 4>, 2>{{{rj, ri, rk, a}, {ri, rj, rk, b}}};
   };
   const RingTriangulation best = triangulate_ring(n, [&](int i, int k, int j, double floor) {
-    const auto tv = tets_of(i, k, j);
-    const double first = tet_quality(m, tv[0]);
-    return first <= floor ? first : std::min(first, tet_quality(m, tv[1]));
+    return value(std::span<const VertId>(ring.data(), static_cast<std::size_t>(n)), std::array<int, 3>{i, k, j},
+                 tets_of(i, k, j), floor);
   });
   plan.after = best.worst;
   if (!(plan.after > 0)) {
@@ -80,6 +84,28 @@ Plan plan_edge_removal(MeshEditor& ed, Cavity& cav, VertId a, VertId b, TetId st
     for (const auto& tv : tets_of(tri[0], tri[1], tri[2])) plan.fill.push_back({tv, region});
   }
   if (plan.after <= plan.before) plan.refusal = Refusal::kNoImprovement;
+  return plan;
+}
+
+}  // namespace
+
+Plan plan_edge_removal(MeshEditor& ed, Cavity& cav, VertId a, VertId b, TetId start) {
+  const auto& m = ed.mesh();
+  return plan_ring_fill(ed, cav, a, b, start,
+                        [&m](std::span<const VertId>, const std::array<int, 3>&,
+                             const std::array<std::array<VertId, 4>, 2>& tv, double floor) {
+                          const double first = tet_quality(m, tv[0]);
+                          return first <= floor ? first : std::min(first, tet_quality(m, tv[1]));
+                        });
+}
+
+Plan plan_edge_removal(MeshEditor& ed, Cavity& cav, VertId a, VertId b, TetId start, const RingTriangleValue& value) {
+  Plan plan = plan_ring_fill(ed, cav, a, b, start,
+                             [&value](std::span<const VertId> ring, const std::array<int, 3>& ikj,
+                                      const std::array<std::array<VertId, 4>, 2>& tv,
+                                      double) { return value(ring, ikj, tv); });
+  // The caller's values are not qualities: "before" means nothing here.
+  if (plan.refusal == Refusal::kNoImprovement && !plan.fill.empty()) plan.refusal = Refusal::kNone;
   return plan;
 }
 

@@ -12,6 +12,9 @@
 // Plans are evaluated first; nothing changes until apply(). Faces marked on
 // the editor (boundary triangles) are never removed, and cavities never mix
 // regions.
+#include <array>
+#include <functional>
+#include <span>
 #include <vector>
 
 #include "curvemesh/modify/cavity.hpp"
@@ -33,6 +36,17 @@ inline constexpr int kMaxShell = kMaxRing;
 
 /// Plans the removal of edge (a, b); `start` is a live tet containing it.
 Plan plan_edge_removal(MeshEditor& ed, Cavity& cavity, VertId a, VertId b, TetId start);
+/// Rates ring triangle (ring[i], ring[k], ring[j]), i < k < j, of an edge
+/// removal by the two tets (a-side, b-side) it would make; higher is better,
+/// <= 0 forbids the triangle. `ring` is the shell's ring in order.
+using RingTriangleValue = std::function<double(std::span<const VertId> ring, const std::array<int, 3>& ikj,
+                                               const std::array<std::array<VertId, 4>, 2>& tets)>;
+/// Edge removal for a purpose other than quality (as boundary recovery
+/// wanting a given face): the ring triangulation maximizing the worst value.
+/// Refused (kNotStarShaped) when every triangulation has a value <= 0; never
+/// refused for not improving, and plan.before is then meaningless. The
+/// value must refuse inverted tets itself (tet_quality does).
+Plan plan_edge_removal(MeshEditor& ed, Cavity& cavity, VertId a, VertId b, TetId start, const RingTriangleValue& value);
 /// Plans the 2-3 swap of face f of tet t.
 Plan plan_face_swap(MeshEditor& ed, Cavity& cavity, TetId t, int f);
 /// Applies a plan made with this cavity (no other cavity use in between).
