@@ -8,6 +8,7 @@
 #include <random>
 #include <set>
 
+#include "../common/delaunay_support.hpp"
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/generate/delaunay3d.hpp"
 #include "curvemesh/generate/spatial_sort.hpp"
@@ -25,18 +26,7 @@ struct Built {
 
 Built triangulate(const std::vector<Vec3>& pts) {
   Built b;
-  Vec3 lo = pts[0], hi = pts[0];
-  for (const Vec3& p : pts) {
-    b.m.add_vert(p);
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  b.m.resize_vertex_arrays();
-  std::vector<VertId> ids(pts.size());
-  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<VertId>(i);
-  Delaunay3d dt(b.m, lo, hi);
-  b.dup = dt.insert_all(ids);
-  dt.editor().compact();
+  test::triangulate_points(b.m, pts, &b.dup)->editor().compact();
   return b;
 }
 

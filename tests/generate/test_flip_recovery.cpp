@@ -10,6 +10,7 @@
 #include <random>
 #include <set>
 
+#include "../common/delaunay_support.hpp"
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/generate/boundary_recovery.hpp"
 #include "curvemesh/generate/delaunay3d.hpp"
@@ -28,18 +29,8 @@ struct Built {
 };
 
 void triangulate(Built& b, const std::vector<Vec3>& pts) {
-  Vec3 lo = pts[0], hi = pts[0];
-  for (const Vec3& p : pts) {
-    b.m.add_vert(p);
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  b.m.resize_vertex_arrays();
   b.n = pts.size();
-  std::vector<VertId> ids(pts.size());
-  for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<VertId>(i);
-  b.dt = std::make_unique<Delaunay3d>(b.m, lo, hi);
-  b.dt->insert_all(ids);
+  b.dt = test::triangulate_points(b.m, pts);
 }
 
 // Every live tet positive, adjacency symmetric with matching vertex sets,
