@@ -83,6 +83,11 @@ Vec2 metric_normal(const Vec2& e, const Metric2& m) {
 }
 
 constexpr double kHalfSqrt3 = 0.8660254037844386;
+// A triangle whose normal turns more than about 80 degrees from the surface's
+// (cosine below this) is treated as folded: it stands nearly edge-on to its
+// face — a fan over a tiny, strongly curved face — and a Steiner point that
+// recovery puts on the face there folds the triangles it splits.
+constexpr double kNearFold = 0.17;
 
 class FaceMesher {
  public:
@@ -436,7 +441,8 @@ class FaceMesher {
     if (xyz_[a] == xyz_[b] || xyz_[b] == xyz_[c] || xyz_[c] == xyz_[a]) return false;  // vanishes at a pole
     const Vec3 n = (xyz_[b] - xyz_[a]).cross(xyz_[c] - xyz_[a]);
     const geom::SurfaceDerivatives d = m_.face_derivatives(face_, (uv_[a] + uv_[b] + uv_[c]) / 3);
-    return !(n.dot(d.du.cross(d.dv)) > 0);
+    const Vec3 sn = d.du.cross(d.dv);
+    return !(n.dot(sn) > kNearFold * n.norm() * sn.norm());
   }
 
   // Triangles that fold against the surface (a sliver of boundary points
