@@ -230,8 +230,14 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   std::unordered_set<std::uint64_t> flip_made;
   std::vector<Triple> all_faces;
   int last_face = 0;
+  // Flips never remove an edge of the surface mesh (present or not), hence
+  // never a recovered edge or triangle.
+  FlipRecovery flips(dt.editor(), [&surf](VertId a, VertId b) { return surf.exists(a, b); });
   auto split_and_insert = [&](VertId a, VertId b) {
     const VertId p = surf.split(a, b, st);
+    // Any flip, even one of a failed attempt, ends Delaunay insertion's
+    // assumption that cavities are star-shaped.
+    if (flips.stats().face_swaps + flips.stats().edge_removals != 0) dt.set_non_delaunay();
     const auto r = dt.insert(p, m.vert2tet[a]);
     if (r.refusal != modify::Refusal::kNone)
       throw GeometryError(fmt::format("face {}: Steiner point {} could not be inserted ({})", last_face, p,
@@ -295,25 +301,7 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     modify::MeshEditor& ed;
     ~HookReset() { ed.set_hook({}); }
   } hook_reset{ed};
-  // Flips never remove an edge of the surface mesh (present or not), hence
-  // never a recovered edge or triangle.
-  FlipRecovery flips(ed, [&surf](VertId a, VertId b) { return surf.exists(a, b); });
-  // A failed attempt may have flipped too: any flip ends Delaunay insertion's
-  // assumption that cavities are star-shaped.
   auto volume_flips_now = [&] { return st.rounds >= o.flips_from_round; };
-  auto flipped_in = [&](bool ok) {
-    if (flips.stats().face_swaps + flips.stats().edge_removals != 0) dt.set_non_delaunay();
-    return ok;
-  };
-  struct FlipStats {
-    RecoveryStats& st;
-    FlipRecovery& flips;
-    ~FlipStats() {
-      st.volume_flips = flips.stats().face_swaps + flips.stats().edge_removals;
-      st.edges_by_volume_flips = flips.stats().edges_recovered;
-      st.triangles_by_volume_flips = flips.stats().triangles_recovered;
-    }
-  } flip_stats{st, flips};
   for (st.rounds = 0;; ++st.rounds) {
     to_split.clear();
     std::size_t missing_tris = 0;
@@ -371,7 +359,7 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
         for (VertId x : v) dirty[x] = 1;
         continue;
       }
-      if (volume_flips_now() && flipped_in(flips.recover_triangle(v[0], v[1], v[2]))) continue;
+      if (volume_flips_now() && flips.recover_triangle(v[0], v[1], v[2])) continue;
       last_face = t.face_tag;
       int longest = 0;
       double best = -1;
@@ -388,7 +376,12 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
       st.missing_edges_initial = missing_edges;
       st.missing_triangles_initial = missing_tris;
     }
-    if (to_split.empty()) return st;
+    if (to_split.empty()) {
+      st.volume_flips = flips.stats().face_swaps + flips.stats().edge_removals;
+      st.edges_by_volume_flips = flips.stats().edges_recovered;
+      st.triangles_by_volume_flips = flips.stats().triangles_recovered;
+      return st;
+    }
     // Surface flips first: a flipped edge needs no Steiner point. Vertices
     // of flipped triangles are checked again next round (no tet changed, so
     // the rebuild hook did not mark them).
@@ -401,14 +394,14 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     std::erase_if(to_split, [&](const std::pair<VertId, VertId>& e) {
       const auto [a, b] = e;
       if (index++ >= missing_edges || !surf.exists(a, b)) return false;
-      if (flip_made.count(edge_key(a, b))) return volume_flips_now() && flipped_in(flips.recover_edge(a, b));
+      if (flip_made.count(edge_key(a, b))) return volume_flips_now() && flips.recover_edge(a, b);
       const auto it = surf.edges().find(edge_key(a, b));
       std::array<VertId, 4> quad{a, b, kNone, kNone};
       if (it != surf.edges().end() && it->second.size() == 2)
         for (int k = 0; k < 2; ++k)
           for (VertId v : m.tris[it->second[k]].verts)
             if (v != a && v != b) quad[2 + k] = v;
-      if (!surf.flip_to_mesh(a, b, ball)) return volume_flips_now() && flipped_in(flips.recover_edge(a, b));
+      if (!surf.flip_to_mesh(a, b, ball)) return volume_flips_now() && flips.recover_edge(a, b);
       flip_made.insert(edge_key(quad[2], quad[3]));
       if (dirty.size() < m.coords.size()) dirty.resize(m.coords.size(), 0);
       for (VertId v : quad) dirty[v] = 1;

@@ -83,11 +83,7 @@ Vec2 metric_normal(const Vec2& e, const Metric2& m) {
 }
 
 constexpr double kHalfSqrt3 = 0.8660254037844386;
-// A triangle whose normal turns more than about 80 degrees from the surface's
-// (cosine below this) is treated as folded: it stands nearly edge-on to its
-// face — a fan over a tiny, strongly curved face — and a Steiner point that
-// recovery puts on the face there folds the triangles it splits.
-constexpr double kNearFold = 0.17;
+constexpr double kNearFold = 0.17;  // cos 80°: see FaceMesher::folds
 
 class FaceMesher {
  public:
@@ -436,7 +432,10 @@ class FaceMesher {
   }
 
   // Whether (a, b, c), positive in (u, v), folds against the surface: its
-  // normal against du × dv at its centroid (as the boundary check judges).
+  // normal against du × dv at its centroid (as the boundary check judges),
+  // turned by more than about 80°. A triangle nearly edge-on to its face (a
+  // fan over a tiny, strongly curved face) counts: a Steiner point that
+  // recovery puts on the face there folds the triangles it splits.
   bool folds(int a, int b, int c) const {
     if (xyz_[a] == xyz_[b] || xyz_[b] == xyz_[c] || xyz_[c] == xyz_[a]) return false;  // vanishes at a pole
     const Vec3 n = (xyz_[b] - xyz_[a]).cross(xyz_[c] - xyz_[a]);
