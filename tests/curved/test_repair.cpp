@@ -148,6 +148,46 @@ TEST(ElementCheck, RecheckWithTheCacheEqualsAFreshCheck) {
   same(curved::check_mesh(r.m, acc, true, &cache), fresh);
 }
 
+// The repair's `origin` names, for each tet it leaves, the entry tet with
+// the same nodes, and only the tets near what it changed are new.
+TEST(ElementCheck, RepairOriginNamesTetsWithTheirEntryNodes) {
+  for (const int order : {2, 3}) {
+    Meshed r = mesh_for_curving("builtin:holes", 0.25);
+    curved::place_boundary_nodes(r.m, *r.model, order);
+    const curved::Acceptance acc;
+    std::vector<curved::ElementCheck> first;
+    const auto before = curved::check_mesh(r.m, acc, true, nullptr, nullptr, &first);
+    ASSERT_GT(before.unacceptable.size(), 0u);
+    ASSERT_EQ(first.size(), r.m.num_tets());
+    std::vector<std::vector<Vec3>> entry;
+    for (TetId t = 0; t < r.m.num_tets(); ++t) entry.push_back(mesh::gather_tet_nodes(r.m, t));
+    curved::RepairOptions o;
+    std::vector<TetId> origin;
+    const auto st = curved::repair_curved_mesh(r.m, *r.model, before.unacceptable, o, &origin);
+    ASSERT_GT(st.edge_removals + st.splits + st.boundary_swaps + st.collapses, 0u);
+    ASSERT_EQ(origin.size(), r.m.num_tets());
+    std::size_t renewed = 0;
+    for (TetId t = 0; t < r.m.num_tets(); ++t) {
+      if (origin[t] == kNone) {
+        ++renewed;
+        continue;
+      }
+      ASSERT_LT(origin[t], entry.size());
+      ASSERT_EQ(mesh::gather_tet_nodes(r.m, t), entry[origin[t]]) << "order " << order << " tet " << t;
+    }
+    EXPECT_GT(renewed, 0u);
+    EXPECT_LT(renewed, r.m.num_tets() / 4) << "order " << order;
+    // recheck_mesh on those origins is a fresh check.
+    const auto again = curved::recheck_mesh(r.m, acc, true, first, origin);
+    const auto fresh = curved::check_mesh(r.m, acc, true);
+    EXPECT_EQ(again.unacceptable, fresh.unacceptable);
+    EXPECT_EQ(again.mean_scaled_jacobian, fresh.mean_scaled_jacobian);
+    EXPECT_EQ(again.min_measure, fresh.min_measure);
+    EXPECT_THROW(curved::recheck_mesh(r.m, acc, true, first, std::span<const TetId>(origin).first(1)),
+                 std::invalid_argument);
+  }
+}
+
 // The least I check_mesh reports is the least exact I over every tet,
 // though it measures only the tets whose bound could hold it.
 TEST(ElementCheck, LeastMeasureIsExact) {
@@ -187,6 +227,15 @@ TEST_P(Repair, EveryElementEndsCertifiedValidAndAcceptable) {
   EXPECT_EQ(rep.after.unacceptable.size(), 0u);
   EXPECT_GE(rep.after.min_scaled_jacobian, o.repair.acceptance.min_scaled_jacobian);
   EXPECT_GE(rep.after.min_measure, o.repair.acceptance.min_measure);
+  // The report after the repair checks only the tets it changed: it is
+  // what a check of the whole mesh gives.
+  const curved::MeshCheck fresh = curved::check_mesh(r.m, o.repair.acceptance, true);
+  EXPECT_EQ(rep.after.invalid, fresh.invalid);
+  EXPECT_EQ(rep.after.unacceptable, fresh.unacceptable);
+  EXPECT_EQ(rep.after.min_scaled_jacobian, fresh.min_scaled_jacobian);
+  EXPECT_EQ(rep.after.mean_scaled_jacobian, fresh.mean_scaled_jacobian);
+  EXPECT_EQ(rep.after.min_measure, fresh.min_measure);
+  EXPECT_EQ(rep.after.quick, fresh.quick);
   // Certified again from scratch, through the quality module directly.
   for (TetId t = 0; t < r.m.num_tets(); ++t)
     ASSERT_EQ(quality::certify_tet(r.m, t).verdict, quality::Validity::kValid) << "tet " << t;

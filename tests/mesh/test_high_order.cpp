@@ -45,6 +45,31 @@ TEST(HighOrder, EdgeNodesAreStoredOncePerEdgeAndReversible) {
   EXPECT_THROW(h.reset(5), std::invalid_argument);
 }
 
+TEST(HighOrder, JournalListsEveryEntitySetOrErasedAndIsNotCopied) {
+  HighOrderNodes h;
+  h.reset(3);
+  const Vec3 e[2] = {Vec3(1, 0, 0), Vec3(2, 0, 0)};
+  const Vec3 f[1] = {Vec3(0, 1, 0)};
+  h.set_edge(4, 9, e);  // before the journal: not listed
+  std::vector<std::array<VertId, 3>> journal;
+  h.set_journal(&journal);
+  h.set_edge(7, 3, e);
+  h.set_face(5, 2, 8, f);
+  h.erase_edge(9, 4);
+  h.erase_face(8, 5, 2);
+  h.erase_edge(1, 2);  // nothing stored: listed all the same
+  const HighOrderNodes copy = h;
+  HighOrderNodes assigned;
+  assigned = h;
+  HighOrderNodes(copy).set_edge(0, 1, e);
+  assigned.set_edge(0, 1, e);
+  h.set_journal(nullptr);
+  h.set_edge(0, 1, e);
+  const std::vector<std::array<VertId, 3>> expected{
+      {3, 7, kNone}, {2, 5, 8}, {4, 9, kNone}, {2, 5, 8}, {1, 2, kNone}};
+  EXPECT_EQ(journal, expected);
+}
+
 TEST(HighOrder, ScatterGatherRoundTripSharesNodesBetweenTets) {
   for (int p : {2, 3}) {
     TetMesh m = make_box_mesh({2, 2, 2}, Vec3(0, 0, 0), Vec3(1, 1, 1), false);

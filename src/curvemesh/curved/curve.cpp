@@ -80,25 +80,26 @@ CurveReport curve_mesh(mesh::TetMesh& m, const geom::Model& model, const CurveOp
   r.placement = place_boundary_nodes(m, model, o.order);
   r.place_seconds = step.seconds();
   step.reset();
-  // Before: what to repair, keeping every curved tet's result so that the
-  // report after the repair redoes only the tets whose nodes it changed.
-  CheckCache seen;
-  const MeshCheck before = check_mesh(m, o.repair.acceptance, true, nullptr, &seen);
+  // Before: what to repair, keeping every tet's result so that the report
+  // after the repair redoes only the tets it changed.
+  std::vector<ElementCheck> seen;
+  const MeshCheck before = check_mesh(m, o.repair.acceptance, true, nullptr, nullptr, &seen);
   r.invalid_before = before.invalid.size();
   r.unacceptable_before = before.unacceptable.size();
   r.min_scaled_jacobian_before = before.min_scaled_jacobian;
   r.min_measure_before = before.min_measure;
   r.check_seconds = step.seconds();
   const bool repairs = o.repair_enabled && !before.unacceptable.empty();
+  std::vector<TetId> origin;
   if (repairs) {
-    r.repair = repair_curved_mesh(m, model, before.unacceptable, o.repair);
+    r.repair = repair_curved_mesh(m, model, before.unacceptable, o.repair, &origin);
     // Tet adjacency does not change with the vertex numbers; vert2tet is
     // renumbered with them.
     mesh::drop_unused_vertices(m);
   }
   step.reset();
   // Untouched, the mesh checks as it did.
-  r.after = repairs ? check_mesh(m, o.repair.acceptance, true, &seen) : before;
+  r.after = repairs ? recheck_mesh(m, o.repair.acceptance, true, seen, origin) : before;
   r.check_seconds += step.seconds();
   step.reset();
   r.error_straight = measure_geometric_error(m, model, true);

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <bit>
+#include <stdexcept>
 
+#include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
@@ -202,49 +204,20 @@ ElementCheck check_tet(const mesh::TetMesh& m, TetId t, const Acceptance& accept
   return check_element(m.high_order.order(), mesh::tet_nodes(m, m.tet2verts[t]).view(), acceptance, exact_measure);
 }
 
-MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_minima,
-                     const CheckCache* reuse, CheckCache* keep) {
-  const std::size_t nt = m.num_tets();
+namespace {
+
+// What check_mesh and recheck_mesh share once each tet has its first-pass
+// result: the exact minima (see check_mesh) and the summary.
+MeshCheck summarize(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_minima,
+                    std::vector<ElementCheck>& checks) {
+  const std::size_t nt = checks.size();
   const int order = m.high_order.order();
-  const std::size_t per_tet = mesh::tet_node_count(order);
-  if (reuse && reuse->order() != order) reuse = nullptr;
-  // Curved tets get consecutive entries in `keep`, in tet order.
-  std::vector<std::uint32_t> entry(nt + 1, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) entry[t + 1] = !plainly_straight(m, static_cast<TetId>(t));
-  });
-  for (std::size_t t = 0; t < nt; ++t) entry[t + 1] += entry[t];
-  if (keep) {
-    // Filled in place by the parallel loop, indexed after it.
-    *keep = CheckCache(order);
-    keep->nodes_.resize(std::size_t(entry[nt]) * per_tet);
-    keep->checks_.resize(entry[nt]);
-  }
-  std::vector<ElementCheck> checks(nt);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 256), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) {
-      const auto tet = static_cast<TetId>(t);
-      if (entry[t + 1] == entry[t]) {
-        checks[t] = check_straight(m, tet, acceptance);
-        continue;
-      }
-      const mesh::TetNodes gathered = mesh::tet_nodes(m, m.tet2verts[tet]);
-      const std::span<const Vec3> nodes = gathered.view();
-      const ElementCheck* known = reuse ? reuse->find(nodes) : nullptr;
-      checks[t] = known ? *known : check_element(order, nodes, acceptance, false, true, true);
-      if (keep) {
-        std::copy(nodes.begin(), nodes.end(), keep->nodes_.begin() + std::ptrdiff_t(std::size_t(entry[t]) * per_tet));
-        keep->checks_[entry[t]] = checks[t];
-      }
-    }
-  });
   MeshCheck out;
-  // `keep` holds what the first pass computed: a check that reuses it then
-  // makes the same full certifications below and gives what a fresh one
-  // gives (a few tets; the first pass is the cost).
   // Certified in full, lowest bound first, the tets whose bound is under
   // the least exact value found so far (`exact` tells a tet already has
-  // it, `bound` reads the value or its lower bound).
+  // it, `bound` reads the value or its lower bound). A check that reuses
+  // first-pass results then makes the same full certifications here and
+  // gives what a fresh one gives (a few tets; the first pass is the cost).
   const auto settle_least = [&](auto exact, auto bound, bool exact_measure) {
     double least = 1;
     std::vector<std::pair<double, TetId>> open;
@@ -283,8 +256,77 @@ MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool 
     sum_sj += c.scaled_jacobian;
   }
   if (nt) out.mean_scaled_jacobian = sum_sj / double(nt);
+  return out;
+}
+
+// The first-pass result of tet t, given its nodes.
+ElementCheck first_pass(int order, std::span<const Vec3> nodes, const Acceptance& acceptance) {
+  return check_element(order, nodes, acceptance, false, true, true);
+}
+
+}  // namespace
+
+MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_minima,
+                     const CheckCache* reuse, CheckCache* keep, std::vector<ElementCheck>* first_results) {
+  const std::size_t nt = m.num_tets();
+  const int order = m.high_order.order();
+  const std::size_t per_tet = mesh::tet_node_count(order);
+  if (reuse && reuse->order() != order) reuse = nullptr;
+  // Curved tets get consecutive entries in `keep`, in tet order.
+  std::vector<std::uint32_t> entry(nt + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) entry[t + 1] = !plainly_straight(m, static_cast<TetId>(t));
+  });
+  for (std::size_t t = 0; t < nt; ++t) entry[t + 1] += entry[t];
+  if (keep) {
+    // Filled in place by the parallel loop, indexed after it.
+    *keep = CheckCache(order);
+    keep->nodes_.resize(std::size_t(entry[nt]) * per_tet);
+    keep->checks_.resize(entry[nt]);
+  }
+  std::vector<ElementCheck> checks(nt);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      const auto tet = static_cast<TetId>(t);
+      if (entry[t + 1] == entry[t]) {
+        checks[t] = check_straight(m, tet, acceptance);
+        continue;
+      }
+      const mesh::TetNodes gathered = mesh::tet_nodes(m, m.tet2verts[tet]);
+      const std::span<const Vec3> nodes = gathered.view();
+      const ElementCheck* known = reuse ? reuse->find(nodes) : nullptr;
+      checks[t] = known ? *known : first_pass(order, nodes, acceptance);
+      if (keep) {
+        std::copy(nodes.begin(), nodes.end(), keep->nodes_.begin() + std::ptrdiff_t(std::size_t(entry[t]) * per_tet));
+        keep->checks_[entry[t]] = checks[t];
+      }
+    }
+  });
+  if (first_results) *first_results = checks;
+  MeshCheck out = summarize(m, acceptance, exact_minima, checks);
   if (keep) keep->index_all();
   return out;
+}
+
+MeshCheck recheck_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_minima,
+                       std::span<const ElementCheck> previous, std::span<const TetId> origin) {
+  const std::size_t nt = m.num_tets();
+  if (origin.size() != nt)
+    throw std::invalid_argument(fmt::format("recheck_mesh: {} origins for {} tets", origin.size(), nt));
+  const int order = m.high_order.order();
+  std::vector<ElementCheck> checks(nt);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      const auto tet = static_cast<TetId>(t);
+      if (origin[t] != kNone && origin[t] < previous.size())
+        checks[t] = previous[origin[t]];
+      else if (plainly_straight(m, tet))
+        checks[t] = check_straight(m, tet, acceptance);
+      else
+        checks[t] = first_pass(order, mesh::tet_nodes(m, m.tet2verts[tet]).view(), acceptance);
+    }
+  });
+  return summarize(m, acceptance, exact_minima, checks);
 }
 
 }  // namespace cm::curved

@@ -95,14 +95,15 @@ struct MeshCheck {
 };
 class CheckCache;
 MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_minima,
-                     const CheckCache* reuse, CheckCache* keep);
+                     const CheckCache* reuse, CheckCache* keep, std::vector<ElementCheck>* first_results);
 
 /// Check results keyed by the tet's nodes, compared exactly (never by tet
 /// id, so a moved vertex or a reused id cannot hit a stale result). A
-/// check_mesh fills one with what it saw of the tets whose nodes are off
-/// the straight tet, so that checking the mesh again after a few local
-/// changes (the repair) redoes only the tets whose nodes changed; the
-/// repair uses one as a memo of the candidates it judges again and again.
+/// check_mesh can fill one with what it saw of the tets whose nodes are off
+/// the straight tet, so that checking the mesh again after local changes
+/// nobody tracked redoes only the tets whose nodes changed (where the
+/// changes are known, recheck_mesh is cheaper); the repair uses one as a
+/// memo of the candidates it judges again and again.
 class CheckCache {
  public:
   CheckCache() = default;
@@ -116,7 +117,8 @@ class CheckCache {
   void clear();
 
  private:
-  friend MeshCheck check_mesh(const mesh::TetMesh&, const Acceptance&, bool, const CheckCache*, CheckCache*);
+  friend MeshCheck check_mesh(const mesh::TetMesh&, const Acceptance&, bool, const CheckCache*, CheckCache*,
+                              std::vector<ElementCheck>*);
   void index_all();
   int order_ = 0;
   std::size_t per_tet_ = 0;
@@ -144,8 +146,21 @@ class CheckCache {
 /// the mesh (at least the full certification of every tet would give) and
 /// min_measure the least I exactly (I is at least the scaled Jacobian
 /// bound). With `reuse`, results of tets found there are taken as they
-/// are; with `keep`, the curved tets' nodes and results are stored there.
+/// are; with `keep`, the curved tets' nodes and results are stored there;
+/// with `first_results`, every tet's result as the first pass found it
+/// (before the exact minima), in tet order, for recheck_mesh.
 MeshCheck check_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_minima = true,
-                     const CheckCache* reuse = nullptr, CheckCache* keep = nullptr);
+                     const CheckCache* reuse = nullptr, CheckCache* keep = nullptr,
+                     std::vector<ElementCheck>* first_results = nullptr);
+
+/// check_mesh of a mesh that an edit changed in a few places, given what
+/// it was before: tet t is taken as first_results[origin[t]] of an earlier
+/// check_mesh (same acceptance) where origin[t] != kNone, and checked
+/// anew elsewhere. Gives what check_mesh gives, provided each origin[t]
+/// names a tet that had the same nodes (as repair_curved_mesh's `origin`
+/// does); its cost is the changed tets'. Throws std::invalid_argument
+/// unless origin has one entry per tet.
+MeshCheck recheck_mesh(const mesh::TetMesh& m, const Acceptance& acceptance, bool exact_minima,
+                       std::span<const ElementCheck> first_results, std::span<const TetId> origin);
 
 }  // namespace cm::curved

@@ -1,6 +1,7 @@
 #include "curvemesh/curved/repair.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <vector>
 
 #include "curvemesh/core/timer.hpp"
@@ -108,6 +109,11 @@ void Repairer::recheck_face(VertId a, VertId b, VertId c) {
 }
 
 void Repairer::after_edit(std::span<const TetId> created) {
+  if (origin_)
+    for (TetId t : created) {
+      if (rebuilt_.size() <= t) rebuilt_.resize(std::max<std::size_t>(t + 1, m_.tet2verts.size()), 0);
+      rebuilt_[t] = 1;
+    }
   const std::size_t first = created_.size();
   created_.insert(created_.end(), created.begin(), created.end());
   std::vector<std::uint64_t> seen;
@@ -251,9 +257,39 @@ RepairStats Repairer::run(std::span<const TetId> unacceptable) {
   // What is left of them: straightening takes back interior curving first.
   st_.interior_edges_curved = interior_curved_.size();
   ed_.set_hook({});
-  ed_.compact();
+  if (!origin_) {
+    ed_.compact();
+  } else {
+    m_.high_order.set_journal(nullptr);
+    const std::vector<char> changed = changed_tets();
+    const std::vector<TetId> remap = ed_.compact();
+    origin_->assign(m_.tet2verts.size(), kNone);
+    for (TetId t = 0; t < entry_tets_; ++t)
+      if (remap[t] != kNone && !changed[t]) (*origin_)[remap[t]] = t;
+  }
   st_.seconds = timer.seconds();
   return st_;
+}
+
+std::vector<char> Repairer::changed_tets() {
+  std::vector<char> changed(m_.tet2verts.size(), 0);
+  for (TetId t = 0; t < rebuilt_.size() && t < changed.size(); ++t) changed[t] = rebuilt_[t];
+  std::sort(journal_.begin(), journal_.end());
+  journal_.erase(std::unique(journal_.begin(), journal_.end()), journal_.end());
+  std::array<Vec3, mesh::kMaxOrder> before{}, now{};
+  for (const auto& [a, b, c] : journal_) {
+    // Most entries are a candidate's nodes, set and put back.
+    const bool is_edge = c == kNone;
+    const bool had = is_edge ? entry_nodes_.get_edge(a, b, before.data()) : entry_nodes_.get_face(a, b, c, before.data());
+    const bool has = is_edge ? m_.high_order.get_edge(a, b, now.data()) : m_.high_order.get_face(a, b, c, now.data());
+    const std::size_t n = is_edge ? m_.high_order.nodes_per_edge() : m_.high_order.nodes_per_face();
+    if (had == has && (!had || std::equal(before.begin(), before.begin() + std::ptrdiff_t(n), now.begin()))) continue;
+    const TetId t = find_tet_with(a, b);
+    if (t == kNone) continue;  // gone with every tet that held it
+    for (TetId s : mesh::collect_shell(m_, a, b, t).tets)
+      if (is_edge || mesh::local_index(m_, s, c) >= 0) changed[s] = 1;
+  }
+  return changed;
 }
 
 }  // namespace cm::curved::detail
@@ -261,9 +297,15 @@ RepairStats Repairer::run(std::span<const TetId> unacceptable) {
 namespace cm::curved {
 
 RepairStats repair_curved_mesh(mesh::TetMesh& m, const geom::Model& model, std::span<const TetId> unacceptable,
-                               const RepairOptions& options) {
-  if (m.high_order.order() < 2 || unacceptable.empty()) return {};
-  detail::Repairer r(m, model, options);
+                               const RepairOptions& options, std::vector<TetId>* origin) {
+  if (m.high_order.order() < 2 || unacceptable.empty()) {
+    if (origin) {
+      origin->resize(m.num_tets());
+      std::iota(origin->begin(), origin->end(), TetId{0});
+    }
+    return {};
+  }
+  detail::Repairer r(m, model, options, origin);
   return r.run(unacceptable);
 }
 

@@ -10,7 +10,9 @@
 //    tet's interior edges (the shell's ring retriangulated by dynamic
 //    programming maximizing the worst curved quality), the 2-3 swap of its
 //    interior faces, and the swap of its curved face edges on their model
-//    face (modify/boundary_swap.hpp);
+//    face (modify/boundary_swap.hpp). The ring triangulations best for the
+//    straight tets are tried first, and taken when every tet they make is
+//    acceptable curved: most of the time, at a fraction of the cost;
 // 2. element deletion with reclassification of interior entities onto the
 //    boundary (modify/delete_tet.hpp): a tet with two or three faces on one
 //    model face — curved, its boundary edges meet tangent to the face and
@@ -98,8 +100,11 @@ struct RepairStats {
 /// mesh is valid; `model` is the mesh's model (its tags those of the
 /// classification). On return the mesh is compact (tets renumbered, unused
 /// vertices kept), adjacency valid, and with step 6 enabled every tet is
-/// certified valid and acceptable.
+/// certified valid and acceptable. With `origin`, origin[t] is, for each
+/// tet t on return, the id it had on entry when it is that tet with the
+/// same nodes (no edit rebuilt it, none of its edges and faces has other
+/// nodes), else kNone: what recheck_mesh needs to check only what changed.
 RepairStats repair_curved_mesh(mesh::TetMesh& m, const geom::Model& model, std::span<const TetId> unacceptable,
-                               const RepairOptions& options = {});
+                               const RepairOptions& options = {}, std::vector<TetId>* origin = nullptr);
 
 }  // namespace cm::curved

@@ -16,6 +16,7 @@ bool Repairer::reposition(TetId t) {
   for (VertId v : tv) {
     if (m_.vert_class[v].dim != 3) continue;
     mesh::collect_ball(m_, v, ball);
+    sort_worst_first(ball);
     const Vec3 start = m_.coords[v];
     const Outcome before = evaluate_tets(ball);
     // Pattern search on the worst curved quality of the ball: axis moves
@@ -43,9 +44,8 @@ bool Repairer::reposition(TetId t) {
                                         Vec3(0, 0, step), Vec3(0, 0, -step), (centroid - x).normalized() * step};
         for (const Vec3& d : moves) {
           m_.coords[v] = x + d;
-          const Outcome o = evaluate_tets(ball);
-          if (ranks_above(o, current) && o.straight_ok && (o.bad < current.bad || o.worst > current.worst + kGain)) {
-            current = o;
+          if (const std::optional<Outcome> o = step_up(ball, current)) {
+            current = *o;
             x = x + d;
             moved = true;
           }
@@ -79,8 +79,9 @@ void Repairer::curve_interior(TetId t) {
       const VertId corner = tv[c.where.index];
       if (a != corner && b != corner) continue;
     }
-    const mesh::Shell shell = mesh::collect_shell(m_, a, b, t);
-    const Outcome before = evaluate_tets(shell.tets);
+    std::vector<TetId> shell = mesh::collect_shell(m_, a, b, t).tets;
+    sort_worst_first(shell);
+    const Outcome before = evaluate_tets(shell);
     if (before.bad == 0) continue;
     const Vec3 xa = m_.coords[a], xb = m_.coords[b];
     const double len = (xb - xa).norm();
@@ -106,9 +107,8 @@ void Repairer::curve_interior(TetId t) {
           Vec3 d = Vec3::Zero();
           d[axis / 2] = axis % 2 ? -step : step;
           set(offset + d);
-          const Outcome o = evaluate_tets(shell.tets);
-          if (o.straight_ok && (o.bad < current.bad || (o.bad == current.bad && o.worst > current.worst + kGain))) {
-            current = o;
+          if (const std::optional<Outcome> o = step_up(shell, current)) {
+            current = *o;
             offset += d;
             moved = true;
           }
@@ -118,7 +118,7 @@ void Repairer::curve_interior(TetId t) {
     if (improves(current, before)) {
       set(offset);
       interior_curved_.insert(edge_key(a, b));
-      touched_.insert(touched_.end(), shell.tets.begin(), shell.tets.end());
+      touched_.insert(touched_.end(), shell.begin(), shell.end());
     } else {
       m_.high_order.erase_edge(a, b);
     }

@@ -223,6 +223,7 @@ void HighOrderNodes::set_edge(VertId a, VertId b, std::span<const Vec3> nodes_fr
   const std::size_t n = nodes_per_edge();
   CM_ASSERT_OP(nodes_from_a.size(), ==, n);
   if (n == 0) return;
+  if (journal_.to) journal_.to->push_back(edge_triple(a, b));
   const auto [slot, inserted] = edge_slot_.insert(edge_triple(a, b));
   if (inserted) *slot = take_slot(free_edge_slots_, edge_nodes_, n);
   Vec3* dst = edge_nodes_.data() + std::size_t{*slot} * n;
@@ -243,6 +244,7 @@ void HighOrderNodes::set_face(VertId a, VertId b, VertId c, std::span<const Vec3
   const std::size_t n = nodes_per_face();
   CM_ASSERT_OP(nodes.size(), ==, n);
   if (n == 0) return;
+  if (journal_.to) journal_.to->push_back(sorted_key(a, b, c));
   const auto [slot, inserted] = face_slot_.insert(sorted_key(a, b, c));
   if (inserted) *slot = take_slot(free_face_slots_, face_nodes_, n);
   Vec3* dst = face_nodes_.data() + std::size_t{*slot} * n;
@@ -303,10 +305,12 @@ bool HighOrderNodes::has_face(VertId a, VertId b, VertId c) const {
 }
 
 void HighOrderNodes::erase_edge(VertId a, VertId b) {
+  if (journal_.to) journal_.to->push_back(edge_triple(a, b));
   if (const auto slot = edge_slot_.erase(edge_triple(a, b))) free_edge_slots_.push_back(*slot);
 }
 
 void HighOrderNodes::erase_face(VertId a, VertId b, VertId c) {
+  if (journal_.to) journal_.to->push_back(sorted_key(a, b, c));
   if (const auto slot = face_slot_.erase(sorted_key(a, b, c))) free_face_slots_.push_back(*slot);
 }
 

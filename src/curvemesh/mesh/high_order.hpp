@@ -62,6 +62,14 @@ class HighOrderNodes {
   /// compaction does); entries on a vertex mapped to kNone are dropped.
   void remap_vertices(std::span<const VertId> old2new);
 
+  /// While set, set_edge, erase_edge, set_face and erase_face append the
+  /// entity they are given to *journal (sorted vertex ids; an edge's third
+  /// is kNone), whether or not its nodes change: with a copy taken before,
+  /// a caller finds what an algorithm changed by comparing those entities
+  /// alone. reset and remap_vertices are not journaled. A copy of this
+  /// object does not journal.
+  void set_journal(std::vector<std::array<VertId, 3>>* journal) { journal_.to = journal; }
+
   std::size_t num_edges() const { return edge_slot_.size; }
   std::size_t num_faces() const { return face_slot_.size; }
   std::size_t nodes_per_edge() const { return order_ > 1 ? order_ - 1 : 0; }
@@ -99,6 +107,13 @@ class HighOrderNodes {
   // Slots of erased entries, reused first: curving repairs erase and set
   // nodes many times over.
   std::vector<std::uint32_t> free_edge_slots_, free_face_slots_;
+  struct Journal {
+    std::vector<std::array<VertId, 3>>* to = nullptr;
+    Journal() = default;
+    Journal(const Journal&) {}
+    Journal& operator=(const Journal&) { return *this; }
+  };
+  Journal journal_;
 };
 
 struct TetMesh;

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <tuple>
 #include <unordered_set>
@@ -29,6 +30,7 @@
 #include "curvemesh/modify/marks.hpp"
 #include "curvemesh/modify/split.hpp"
 #include "curvemesh/modify/surface.hpp"
+#include "curvemesh/optimize/measured_swap.hpp"
 
 namespace cm::curved::detail {
 
@@ -144,7 +146,9 @@ class ScratchVertex {
 
 class Repairer {
  public:
-  Repairer(mesh::TetMesh& m, const geom::Model& model, const RepairOptions& o)
+  // With `origin`, run() writes there, for each tet on return, the id it
+  // had on entry if it is that tet with the same nodes, else kNone.
+  Repairer(mesh::TetMesh& m, const geom::Model& model, const RepairOptions& o, std::vector<TetId>* origin)
       : m_(m),
         model_(model),
         o_(o),
@@ -152,10 +156,19 @@ class Repairer {
         boundary_(m),
         placer_(m, model),
         order_(m.high_order.order()),
-        memo_(order_, o.acceptance) {
+        memo_(order_, o.acceptance),
+        origin_(origin),
+        entry_tets_(m.tet2verts.size()) {
     modify::mark_boundary_faces(ed_);
     ed_.set_hook([this](const mesh::TetMesh&, std::span<const TetId> created) { after_edit(created); });
+    if (origin_) {
+      entry_nodes_ = m_.high_order;
+      m_.high_order.set_journal(&journal_);
+    }
   }
+  ~Repairer() { m_.high_order.set_journal(nullptr); }
+  Repairer(const Repairer&) = delete;
+  Repairer& operator=(const Repairer&) = delete;
 
   RepairStats run(std::span<const TetId> unacceptable);
 
@@ -196,6 +209,37 @@ class Repairer {
     return evaluate(v);
   }
   bool acceptable(TetId t) const { return check(m_.tet2verts[t]).acceptable; }
+  // The pattern searches' rule (steps 4 and 5): a move is taken when it
+  // leaves fewer unacceptable tets, or as many with a worst score higher by
+  // kGain. Judged tet by tet, a move is refused as soon as it cannot meet
+  // the rule (the count only grows, the worst only falls), which is where
+  // most moves end: `tets` worst first makes that early.
+  // Also what finds the retriangulations that resolve (current: none
+  // unacceptable, any worst).
+  template <class Tets>
+  std::optional<Outcome> step_up(const Tets& tets, const Outcome& current) const {
+    Outcome out;
+    for (const auto& t : tets) {
+      const Verts& v = verts_of(t);
+      if (!straight_positive(m_, v)) return std::nullopt;
+      const ElementCheck c = check(v);
+      out.bad += !c.acceptable;
+      out.worst = std::min(out.worst, c.score());
+      if (out.bad > current.bad || (out.bad == current.bad && out.worst <= current.worst + kGain))
+        return std::nullopt;
+    }
+    return out;
+  }
+  const Verts& verts_of(TetId t) const { return m_.tet2verts[t]; }
+  static const Verts& verts_of(const Verts& v) { return v; }
+  // The tets worst first, for step_up.
+  void sort_worst_first(std::vector<TetId>& tets) const {
+    std::vector<std::pair<double, TetId>> scored;
+    scored.reserve(tets.size());
+    for (TetId t : tets) scored.emplace_back(check(m_.tet2verts[t]).score(), t);
+    std::sort(scored.begin(), scored.end());
+    for (std::size_t i = 0; i < tets.size(); ++i) tets[i] = scored[i].second;
+  }
 
   // --- nodes of the entities an edit creates -------------------------------
   // The model entity edge (a, b) of live tet t lies on: a model edge, a
@@ -214,6 +258,21 @@ class Repairer {
 
   // --- steps ---------------------------------------------------------------
   void note_problem(TetId t, const ElementCheck& c);
+  // An edge removal (kind 0, local edge) or 2-3 face swap (kind 1, local
+  // face) of a tet, and what it leaves.
+  struct Retriangulation {
+    int kind = -1;
+    int local = 0;
+    Outcome after;
+  };
+  modify::Plan plan_retriangulation(TetId t, const Retriangulation& r, optimize::TetMeasure measure,
+                                    const void* context);
+  // The best of t's retriangulations, each planned to maximize `measure`
+  // and judged curved: among those that make progress, or with
+  // `resolving_only` among those that leave every new tet acceptable.
+  Retriangulation best_retriangulation(TetId t, optimize::TetMeasure measure, const void* context,
+                                       bool resolving_only);
+  bool apply_retriangulation(TetId t, const Retriangulation& r, optimize::TetMeasure measure, const void* context);
   bool retriangulate(TetId t);
   bool delete_element(TetId t);
   bool remesh(TetId t);
@@ -260,6 +319,16 @@ class Repairer {
   void note_failure(TetId t);
   // Tets whose nodes curve_interior changed.
   std::vector<TetId> touched_;
+  // For `origin`: the nodes on entry, the entities given nodes or stripped
+  // of them since (net change or not), the tet slots edits filled.
+  std::vector<TetId>* origin_;
+  std::size_t entry_tets_;
+  mesh::HighOrderNodes entry_nodes_;
+  std::vector<std::array<VertId, 3>> journal_;
+  std::vector<char> rebuilt_;
+  // Per tet slot (before compaction): rebuilt, or holding an entity whose
+  // nodes differ from those on entry.
+  std::vector<char> changed_tets();
 };
 
 }  // namespace cm::curved::detail
