@@ -9,7 +9,8 @@ namespace cm::curved::detail {
 
 // --- step 3: remeshing -----------------------------------------------------------
 
-Outcome Repairer::judge_split(const modify::SplitPlan& plan, std::vector<TetId> shell) {
+std::optional<Outcome> Repairer::judge_split(const modify::SplitPlan& plan, std::vector<TetId> shell,
+                                             const Outcome& before) {
   const VertId a = plan.a, b = plan.b;
   const mesh::ModelRef on = edge_entity(a, b, shell.front());
   const ScratchVertex p(m_, plan.point, plan.classification, plan.param);
@@ -55,7 +56,7 @@ Outcome Repairer::judge_split(const modify::SplitPlan& plan, std::vector<TetId> 
     fill.push_back(x);
     fill.push_back(y);
   }
-  return evaluate(fill);
+  return step_up(fill, before);
 }
 
 bool Repairer::keeps_chord_rule(VertId from, VertId to, std::span<const TetId> ball) const {
@@ -90,13 +91,10 @@ bool Repairer::keeps_chord_rule(VertId from, VertId to, std::span<const TetId> b
   return true;
 }
 
-Outcome Repairer::judge_collapse(const modify::CollapsePlan& plan, std::vector<TetId> ball) {
+std::optional<Outcome> Repairer::judge_collapse(const modify::CollapsePlan& plan, std::vector<TetId> ball,
+                                                const Outcome& before) {
   const VertId from = plan.from, to = plan.to;
-  if (m_.vert_class[from].dim < 3 && !keeps_chord_rule(from, to, ball)) {
-    Outcome refused;
-    refused.straight_ok = false;
-    return refused;
-  }
+  if (m_.vert_class[from].dim < 3 && !keeps_chord_rule(from, to, ball)) return std::nullopt;
   NodeOverride nodes(m_.high_order);
   std::array<Vec3, mesh::kMaxOrder> buf;
   const std::span<const Vec3> out(buf.data(), order_ - 1);
@@ -135,7 +133,7 @@ Outcome Repairer::judge_collapse(const modify::CollapsePlan& plan, std::vector<T
         nodes.set_face(tri[0], tri[1], tri[2], std::span<const Vec3>(&centre, 1));
       }
     }
-  return evaluate(fill);
+  return step_up(fill, before);
 }
 
 bool Repairer::remesh(TetId t) {
@@ -158,9 +156,9 @@ bool Repairer::remesh(TetId t) {
       const modify::SplitPlan p = modify::plan_split(ed_, cav_, boundary_, a, b, t, &model_);
       if (p.refusal != modify::Refusal::kNone) continue;
       const std::vector<TetId> shell(cav_.tets().begin(), cav_.tets().end());
-      const Outcome before = evaluate_tets(shell);
-      const Outcome after = judge_split(p, shell);
-      if (improves(after, before) || (resolves(after) && before.bad > 0)) candidates.push_back({kSplit, a, b, after});
+      // t, unacceptable, is in the shell: progress is what step_up judges.
+      if (const std::optional<Outcome> after = judge_split(p, shell, evaluate_tets(shell)))
+        candidates.push_back({kSplit, a, b, *after});
     }
     // An interior edge with one end on the boundary: its inner end goes onto
     // the boundary end (seed Fig. 3.7). And a boundary vertex along its own
@@ -173,10 +171,9 @@ bool Repairer::remesh(TetId t) {
       const modify::CollapsePlan p = modify::plan_collapse(ed_, cav_, boundary_, from, to, &model_);
       if (p.refusal != modify::Refusal::kNone) continue;
       const std::vector<TetId> ball(cav_.tets().begin(), cav_.tets().end());
-      const Outcome before = evaluate_tets(ball);
-      const Outcome after = judge_collapse(p, ball);
-      if (improves(after, before) || (resolves(after) && before.bad > 0))
-        candidates.push_back({kCollapse, from, to, after});
+      // t holds `from`: it is in the ball.
+      if (const std::optional<Outcome> after = judge_collapse(p, ball, evaluate_tets(ball)))
+        candidates.push_back({kCollapse, from, to, *after});
     }
   }
   if (candidates.empty()) return false;

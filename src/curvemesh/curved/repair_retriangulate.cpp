@@ -41,18 +41,11 @@ Repairer::Retriangulation Repairer::best_retriangulation(TetId t, optimize::TetM
         continue;
       std::vector<Verts> fill;
       for (const auto& nt : p.fill) fill.push_back(nt.verts);
-      Outcome after;
-      if (resolving_only) {
-        // t, unacceptable, is in the cavity: resolving is progress.
-        const std::optional<Outcome> clean = step_up(fill, none_bad);
-        if (!clean) continue;
-        after = *clean;
-      } else {
-        const Outcome before = evaluate_tets(cav_.tets());
-        after = evaluate(fill);
-        if (!improves(after, before) && !(resolves(after) && before.bad > 0)) continue;
-      }
-      if (best.kind < 0 || ranks_above(after, best.after)) best = {kind, local, after};
+      // t, unacceptable, is in the cavity: progress is fewer unacceptable
+      // tets, or as many and a better worst one, which step_up judges.
+      const std::optional<Outcome> after = step_up(fill, resolving_only ? none_bad : evaluate_tets(cav_.tets()));
+      if (!after) continue;
+      if (best.kind < 0 || ranks_above(*after, best.after)) best = {kind, local, *after};
     }
   return best;
 }

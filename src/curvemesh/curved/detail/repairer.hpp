@@ -282,11 +282,14 @@ class Repairer {
 
   // Candidate judging of the point operators: the tets they would create,
   // with the nodes their new boundary entities would get.
-  Outcome judge_split(const modify::SplitPlan& plan, std::vector<TetId> shell);
+  // Both give nothing when the candidate is no progress over `before` (the
+  // outcome of the tets it replaces), as step_up judges it.
+  std::optional<Outcome> judge_split(const modify::SplitPlan& plan, std::vector<TetId> shell, const Outcome& before);
   // The boundary swap of face edge (a, b); bad = -1 when refused. Leaves the
   // cavity holding the edge's shell.
   Outcome judge_boundary_swap(VertId a, VertId b, TetId t);
-  Outcome judge_collapse(const modify::CollapsePlan& plan, std::vector<TetId> ball);
+  std::optional<Outcome> judge_collapse(const modify::CollapsePlan& plan, std::vector<TetId> ball,
+                                        const Outcome& before);
   bool keeps_chord_rule(VertId from, VertId to, std::span<const TetId> ball) const;
 
   mesh::TetMesh& m_;
