@@ -188,8 +188,11 @@ int run_volume(const MeshCliOptions& o) {
   step.reset();
   if (!o.output.empty()) io::write_mesh(m, o.output);
   const double write_s = step.seconds();
-  const bool ok = valid.valid() && rep.vertices_off_entity == 0 && rep.folded_triangles == 0 &&
-                  (!curving || curve_report_ok(*curving));
+  // The boundary's whole check: a region boundary that is not a closed
+  // manifold (an edge of two model faces' meshes that is no model edge) or
+  // a model face left without triangles is a classification the tets'
+  // validity does not see.
+  const bool ok = valid.valid() && rep.valid() && (!curving || curve_report_ok(*curving));
   const std::size_t steiner = st.recovery.steiner_on_edges + st.recovery.steiner_on_faces;
 
   nlohmann::json j;
@@ -221,7 +224,10 @@ int run_volume(const MeshCliOptions& o) {
                 {"nonconforming", valid.num_nonconforming},
                 {"classification", valid.num_classification},
                 {"vertices_off_entity", rep.vertices_off_entity},
-                {"folded_triangles", rep.folded_triangles}};
+                {"folded_triangles", rep.folded_triangles},
+                {"crossing_pairs", rep.crossing_pairs},
+                {"open_region_edges", rep.open_region_edges},
+                {"unmeshed_faces", rep.unmeshed_faces}};
   j["volume"] = {{"model", vol_model}, {"mesh", vol_mesh}};
   j["optimization"] = {{"edge_removals", opt.edge_removals},
                        {"face_swaps", opt.face_swaps},
@@ -279,11 +285,14 @@ int run_volume(const MeshCliOptions& o) {
                vol_model > 0 ? (vol_mesh - vol_model) / vol_model : 0.0);
     fmt::print("check: {}", ok ? "valid" : "INVALID");
     if (!ok)
-      fmt::print(" ({} validity issues, {} vertices off their entity, {} folded boundary triangles)",
-                 valid.num_issues, rep.vertices_off_entity, rep.folded_triangles);
+      fmt::print(" ({} validity issues, {} vertices off their entity, {} folded boundary triangles, {} crossing "
+                 "triangle pairs, {} open region edges, {} unmeshed faces)",
+                 valid.num_issues, rep.vertices_off_entity, rep.folded_triangles, rep.crossing_pairs,
+                 rep.open_region_edges, rep.unmeshed_faces);
     fmt::print("\n");
     for (std::size_t i = 0; i < std::min<std::size_t>(valid.issues.size(), 5); ++i)
       fmt::print("  {}\n", valid.issues[i].message);
+    for (std::size_t i = 0; i < std::min<std::size_t>(rep.problems.size(), 5); ++i) fmt::print("  {}\n", rep.problems[i]);
     fmt::print("time: load {:.2f} s, size field {:.2f} s, boundary {:.2f} s, delaunay {:.2f} s, recovery {:.2f} s, "
                "regions {:.2f} s, interior {:.2f} s, optimize {:.2f} s, {}check {:.2f} s, write {:.2f} s, total {:.2f} "
                "s\n",

@@ -228,7 +228,7 @@ const Case kCases[] = {
     {"SmallEdges_e1em5", "builtin:smalledges:e=1e-5", false, {1, true}, nullptr},
     {"SmallEdges_e1em5Coarse", "builtin:smalledges:e=1e-5", true, {1, true}, nullptr},
     {"SmallEdges_e1em6", "builtin:smalledges:e=1e-6", false, {1, true},
-     "the surface mesh of a 1e-6 chamfer (ten times the model tolerance) is not manifold: a model edge between two corners of the chamfer is used by four triangles"},
+     "the surface mesh of a 1e-6 chamfer (ten times the model tolerance) is not manifold: the mesh edge between two corners of the chamfer, 1.1e-6 apart and joined by no model edge, is inside the meshes of both faces beside it (four triangles); `curvemesh mesh` reports it INVALID, exit 1 (CliMesh.RegionBoundaryThatIsNotManifoldIsReportedInvalid)"},
     {"SmallEdges_e1em6Coarse", "builtin:smalledges:e=1e-6", true, {1, true},
      "the surface mesh of a 1e-6 chamfer (ten times the model tolerance) is not manifold: a model edge between two corners of the chamfer is used by four triangles"},
     {"Blocks", "builtin:blocks", false, {2, true}, nullptr},
