@@ -53,7 +53,7 @@ bool Repairer::reposition(TetId t) {
       }
     }
     m_.coords[v] = start;
-    if (!improves(current, before) && !(resolves(current) && before.bad > 0)) continue;
+    if (!improves(current, before)) continue;
     cav_.reset(ed_);
     for (TetId s : ball) cav_.add(ed_, s);
     modify::Relocation plan;

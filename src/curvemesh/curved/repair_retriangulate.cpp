@@ -75,7 +75,7 @@ bool Repairer::retriangulate(TetId t) {
     const Outcome candidate = judge_boundary_swap(a, b, t);
     if (candidate.bad < 0) continue;
     const Outcome before = evaluate_tets(cav_.tets());
-    if (!improves(candidate, before) && !(resolves(candidate) && before.bad > 0)) continue;
+    if (!improves(candidate, before)) continue;
     if ((found.kind < 0 && best_swap_edge < 0) || ranks_above(candidate, best)) {
       best = candidate;
       best_swap_edge = local;
@@ -178,7 +178,7 @@ bool Repairer::delete_element(TetId t) {
       }
     after = evaluate_tets(affected);
   }
-  if (!improves(after, before) && !(resolves(after) && before.bad > 0)) return false;
+  if (!improves(after, before)) return false;
   // Planned again: judging used the cavity's tets only, but be exact.
   const modify::TetDeletion p = modify::plan_tet_deletion(ed_, cav_, boundary_, t, &model_);
   const std::array<TetId, 1> gone{t};

@@ -50,8 +50,8 @@ struct Outcome {
   bool straight_ok = true;  // every straight-sided tet strictly positive
 };
 
-inline bool resolves(const Outcome& o) { return o.straight_ok && o.bad == 0; }
-
+// Progress: fewer unacceptable tets (resolving, none left of some,
+// included), or as many and a worst score higher by kGain.
 inline bool improves(const Outcome& after, const Outcome& before) {
   if (!after.straight_ok) return false;
   if (after.bad != before.bad) return after.bad < before.bad;
