@@ -162,6 +162,8 @@ class SizeOctree final : public SizeField {
   // Octants made before the last assign_corners(): any leaf numbered from
   // here on is new since then.
   std::uint32_t cornered_octants_ = 0;
+  // Octant -> its 26 neighbours of its size exist (balance()).
+  std::vector<char> balanced_parent_;
 
   // Corner data, rebuilt by assign_corners().
   std::vector<std::uint32_t> leaves_;                        // octant ids of the leaves, in Morton order

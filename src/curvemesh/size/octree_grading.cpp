@@ -264,16 +264,45 @@ void SizeOctree::build_incidence() {
   for (std::uint32_t l = 0; l < leaf_nodes_.size(); ++l)
     for (std::uint32_t c = 0; c < 8; ++c) incident_[fill[leaf_nodes_[l][c]]++] = 8 * l + c;
 
+  // Hanging corners, found from the corners: a corner whose incident leaves
+  // leave some of the 8 octants around it uncovered lies on the face or edge
+  // of the larger leaf covering them (the tree is 2:1, so at a midpoint of
+  // it). Only corners at a change of level look further than their own
+  // incidence list; probing every leaf's 18 midpoints in the corner map
+  // instead cost a hash lookup each, nearly all of them misses.
   hanging_.clear();
   const auto& mids = midpoints();
-  for (std::uint32_t l = 0; l < leaves_.size(); ++l) {
-    const Octant& o = octants_[leaves_[l]];
-    if (o.level >= opt_.max_depth) continue;
-    const std::uint32_t half = units(o.level) / 2;
-    for (std::size_t k = 0; k < mids.size(); ++k) {
-      const auto& at = mids[k].at;
-      const std::int64_t node = node_of_.find(key(o.ix + at[0] * half, o.iy + at[1] * half, o.iz + at[2] * half));
-      if (node >= 0) hanging_.push_back({l, static_cast<std::uint32_t>(node), static_cast<std::uint8_t>(k)});
+  std::array<std::int8_t, 27> mid_at;
+  mid_at.fill(-1);
+  for (std::size_t k = 0; k < mids.size(); ++k)
+    mid_at[static_cast<std::size_t>(9 * mids[k].at[0] + 3 * mids[k].at[1] + mids[k].at[2])] = static_cast<std::int8_t>(k);
+  const std::int64_t top = std::int64_t{1} << opt_.max_depth;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    unsigned covered = 0;
+    for (std::uint32_t k = incident_start_[v]; k < incident_start_[v + 1]; ++k) covered |= 1u << ((incident_[k] & 7u) ^ 7u);
+    if (covered == 0xffu) continue;
+    const auto& u = node_units_[v];
+    const std::uint32_t start = leaves_[incident_[incident_start_[v]] >> 3];
+    std::array<std::uint32_t, 8> found{};
+    int nfound = 0;
+    for (unsigned b = 0; b < 8; ++b) {
+      if (covered >> b & 1u) continue;
+      std::array<std::int64_t, 3> p{};
+      bool inside = true;
+      for (int a = 0; a < 3; ++a) {
+        p[a] = (b >> a & 1u) ? std::int64_t{u[a]} : std::int64_t{u[a]} - 1;
+        inside = inside && p[a] >= 0 && p[a] < top;
+      }
+      if (!inside) continue;
+      const std::uint32_t q = find_near(start, std::uint32_t(p[0]), std::uint32_t(p[1]), std::uint32_t(p[2]));
+      if (std::find(found.begin(), found.begin() + nfound, q) != found.begin() + nfound) continue;
+      found[static_cast<std::size_t>(nfound++)] = q;
+      const Octant& o = octants_[q];
+      const std::uint32_t half = units(o.level) / 2;
+      const std::uint32_t at[3] = {(u[0] - o.ix) / half, (u[1] - o.iy) / half, (u[2] - o.iz) / half};
+      const int k = mid_at[9 * at[0] + 3 * at[1] + at[2]];
+      CM_ASSERT(k >= 0 && (u[0] - o.ix) % half == 0 && (u[1] - o.iy) % half == 0 && (u[2] - o.iz) % half == 0);
+      hanging_.push_back({static_cast<std::uint32_t>(octant_leaf_[q]), v, static_cast<std::uint8_t>(k)});
     }
   }
   // Conformity is settled finest first and, within a level, in the order
@@ -305,14 +334,25 @@ void SizeOctree::build_incidence() {
 void SizeOctree::grade(std::span<const std::uint32_t> seeds, std::vector<std::uint32_t>& changed) {
   const double rate = kGradeSafety * (opt_.hgrad - 1);
   using Item = std::pair<double, std::uint32_t>;
-  std::vector<Item> heap;
-  heap.reserve(seeds.size());
+  // The seeds, often every corner, are sorted once and merged with a heap
+  // of the corners lowered on the way: the same visiting order as one heap
+  // of everything (by size, then id), without sifting the seeds through it.
+  std::vector<Item> initial;
+  initial.reserve(seeds.size());
   for (const std::uint32_t i : seeds)
-    if (node_value_[i] < opt_.hmax) heap.emplace_back(node_value_[i], i);
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue(std::greater<>{}, std::move(heap));
-  while (!queue.empty()) {
-    const auto [h, a] = queue.top();
-    queue.pop();
+    if (node_value_[i] < opt_.hmax) initial.emplace_back(node_value_[i], i);
+  std::sort(initial.begin(), initial.end());
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+  std::size_t next = 0;
+  while (next < initial.size() || !queue.empty()) {
+    Item item;
+    if (queue.empty() || (next < initial.size() && initial[next] < queue.top())) {
+      item = initial[next++];
+    } else {
+      item = queue.top();
+      queue.pop();
+    }
+    const auto [h, a] = item;
     if (h > node_value_[a]) continue;
     for (std::uint32_t k = incident_start_[a]; k < incident_start_[a + 1]; ++k) {
       const std::uint32_t leaf = incident_[k] >> 3, ca = incident_[k] & 7u;
