@@ -50,12 +50,22 @@ std::array<VertId, 3> sorted3(std::array<VertId, 3> k) {
 // orientation, which region lies on each of its sides; a component takes the
 // region its triangles vote for. Components touching the enclosing tet are
 // outside. Returns the number of triangles whose vote disagreed.
+//
+// The boundary triangles are the faces protect_all() marked: only those are
+// looked up, by binary search, and every other face is crossed at once.
 std::size_t classify_regions(const geom::Model& model, Delaunay3d& dt) {
   auto& m = dt.mesh();
   auto& ed = dt.editor();
   const FaceSides sides = face_sides(model);
-  std::map<std::array<VertId, 3>, std::uint32_t> tri_of;
-  for (std::uint32_t i = 0; i < m.tris.size(); ++i) tri_of[sorted3(m.tris[i].verts)] = i;
+  std::vector<std::pair<std::array<VertId, 3>, std::uint32_t>> tri_of(m.tris.size());
+  for (std::uint32_t i = 0; i < m.tris.size(); ++i) tri_of[i] = {sorted3(m.tris[i].verts), i};
+  std::sort(tri_of.begin(), tri_of.end());
+  const auto find_tri = [&tri_of](const std::array<VertId, 3>& face) {
+    const auto key = sorted3(face);
+    const auto it = std::lower_bound(tri_of.begin(), tri_of.end(), key,
+                                     [](const auto& entry, const auto& k) { return entry.first < k; });
+    return it != tri_of.end() && it->first == key ? it : tri_of.end();
+  };
 
   const std::size_t nt = m.tet2verts.size();
   std::vector<std::int32_t> comp(nt, -1);
@@ -78,7 +88,7 @@ std::size_t classify_regions(const geom::Model& model, Delaunay3d& dt) {
       for (int f = 0; f < 4; ++f) {
         const auto& fv = mesh::kFaceVerts[f];
         const std::array<VertId, 3> face{tv[fv[0]], tv[fv[1]], tv[fv[2]]};
-        if (auto it = tri_of.find(sorted3(face)); it != tri_of.end()) {
+        if (auto it = ed.face_marked(mesh::pack_face(t, f)) ? find_tri(face) : tri_of.end(); it != tri_of.end()) {
           const auto& tri = m.tris[it->second];
           // t's face is oriented out of t: same orientation as the triangle
           // (which follows the face normal) means t is behind the face.
@@ -154,8 +164,6 @@ Vec3 circumcentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMeshOptions& o, VolumeMeshStats& st) {
   auto& m = dt.mesh();
   auto& ed = dt.editor();
-  if (const std::size_t lost = dt.protect_all(m.tris); lost != 0)
-    throw InternalError(fmt::format("interior refinement: {} recovered boundary triangles are no face", lost));
   std::vector<double> vh(m.coords.size(), INFINITY);
   tbb::parallel_for(VertId{0}, static_cast<VertId>(m.coords.size()), [&](VertId v) {
     if (!dt.is_far(v)) vh[v] = size.size(m.coords[v]);
@@ -288,6 +296,10 @@ mesh::TetMesh mesh_volume_from_boundary(const geom::Model& model, const size::Si
   st.recovery = recover_boundary(model, dt, o.recovery);
   st.recovery_seconds = step.seconds();
   step.reset();
+  // Recovered, the boundary is protected: classification reads the marks,
+  // and interior refinement never crosses them.
+  if (const std::size_t lost = dt.protect_all(m.tris); lost != 0 && o.refine)
+    throw InternalError(fmt::format("interior refinement: {} recovered boundary triangles are no face", lost));
   st.region_conflicts = classify_regions(model, dt);
   st.outside_tets = remove_outside(dt);
   st.classify_seconds = step.seconds();
