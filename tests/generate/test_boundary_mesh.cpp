@@ -148,6 +148,34 @@ TEST(BoundaryMesh, BuiltinShapesAreClosedValidAndWellShaped) {
   }
 }
 
+// The check sees a region boundary that is not a closed manifold: a
+// triangle gone leaves its three edges used once, and a triangle repeated
+// with another face's tag puts its edges in three triangles. Neither is a
+// fault of any single triangle or vertex.
+TEST(BoundaryCheck, RegionBoundaryThatIsNotAClosedManifoldIsInvalid) {
+  const auto model = geom_occ::load_model("builtin:box");
+  const auto sf = field(*model, model->bounding_box().diagonal() / 10);
+  const mesh::TetMesh whole = generate::mesh_boundary(*model, *sf.field);
+  expect_valid(*model, whole, *sf.field, "builtin:box");
+
+  mesh::TetMesh open = whole;
+  open.tris.pop_back();
+  const generate::BoundaryReport a = generate::check_boundary(*model, open, *sf.field);
+  EXPECT_FALSE(a.valid());
+  EXPECT_EQ(a.open_region_edges, 3u);
+  EXPECT_EQ(a.vertices_off_entity, 0u);
+  EXPECT_EQ(a.folded_triangles, 0u);
+
+  mesh::TetMesh doubled = whole;
+  mesh::ClassifiedTri extra = doubled.tris.front();
+  extra.face_tag = extra.face_tag % model->count(2) + 1;
+  std::swap(extra.verts[1], extra.verts[2]);
+  doubled.tris.push_back(extra);
+  const generate::BoundaryReport b = generate::check_boundary(*model, doubled, *sf.field);
+  EXPECT_FALSE(b.valid());
+  EXPECT_GT(b.open_region_edges, 0u);
+}
+
 // At a pole the size field shrinks with the distance to the apex and the
 // first fundamental form degenerates in one direction: a mesher that
 // refines isotropically in (u, v) puts hundreds of points on each ring

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -42,8 +43,31 @@ class Surface {
   bool exists(VertId a, VertId b) const { return tris_of_.count(edge_key(a, b)) || segment_of_.count(edge_key(a, b)); }
   bool is_segment(VertId a, VertId b) const { return segment_of_.count(edge_key(a, b)) != 0; }
 
+  /// Mesh edges that the meshes of two or more faces both run inside (no
+  /// model edge joins their ends): a region boundary through such an edge
+  /// is not a manifold. It happens where two faces pass within a hair of
+  /// each other at two shared corners, e.g. beside a chamfer a few model
+  /// tolerances wide. Each entry is (a, b, a face to take the edge out of);
+  /// the face with the smallest tag keeps it.
+  std::vector<std::tuple<VertId, VertId, int>> shared_chords() const {
+    std::vector<std::tuple<VertId, VertId, int>> out;
+    for (const auto& [key, tris] : tris_of_) {
+      if (tris.size() <= 2 || segment_of_.count(key)) continue;
+      std::vector<int> faces;
+      for (const std::uint32_t t : tris) faces.push_back(m_.tris[t].face_tag);
+      std::sort(faces.begin(), faces.end());
+      faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+      for (std::size_t i = 1; i < faces.size(); ++i)
+        out.emplace_back(static_cast<VertId>(key >> 32), static_cast<VertId>(key & 0xffffffffu), faces[i]);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
   /// Splits surface edge (a, b) on its model entity; returns the new vertex.
-  VertId split(VertId a, VertId b, RecoveryStats& st) {
+  /// With `only_face`, an edge inside that face's mesh is split there alone:
+  /// the other faces' triangles keep it.
+  VertId split(VertId a, VertId b, RecoveryStats& st, int only_face = 0) {
     const std::uint64_t key = edge_key(a, b);
     // Where to split: the midpoint, except on an edge from an original
     // vertex to a Steiner point, which is split at a power-of-two distance
@@ -60,7 +84,7 @@ class Surface {
     }
     const Vec3 mid = (1 - w) * m_.coords[a] + w * m_.coords[b];
     VertId p;
-    if (auto seg = segment_of_.find(key); seg != segment_of_.end()) {
+    if (auto seg = segment_of_.find(key); seg != segment_of_.end() && only_face == 0) {
       const int e = m_.edges[seg->second].edge_tag;
       // Halve the parameter interval when both ends have a parameter on the
       // edge: progress is guaranteed even where closest-point projection is
@@ -90,7 +114,7 @@ class Surface {
       ++st.steiner_on_edges;
     } else {
       const auto& around = tris_of_.at(key);
-      const int f = m_.tris[around.front()].face_tag;
+      const int f = only_face != 0 ? only_face : m_.tris[around.front()].face_tag;
       std::optional<Vec2> hint;
       for (std::uint32_t t : around)
         for (VertId v : m_.tris[t].verts)
@@ -103,9 +127,20 @@ class Surface {
       m_.vert_param[p].v = pr.param.y();
       ++st.steiner_on_faces;
     }
-    // Split every triangle on the edge into two, keeping its orientation.
-    const std::vector<std::uint32_t> around = tris_of_[key];
-    tris_of_.erase(key);
+    // Split every triangle on the edge (of that face) into two, keeping its
+    // orientation.
+    std::vector<std::uint32_t> around = tris_of_[key], kept;
+    if (only_face != 0) {
+      std::erase_if(around, [&](std::uint32_t t) {
+        if (m_.tris[t].face_tag == only_face) return false;
+        kept.push_back(t);
+        return true;
+      });
+    }
+    if (kept.empty())
+      tris_of_.erase(key);
+    else
+      tris_of_[key] = kept;
     for (std::uint32_t t : around) {
       auto tv = m_.tris[t].verts;
       int k = 0;  // rotate so that the tri reads (x, y, c) with {x, y} = {a, b}
@@ -233,8 +268,8 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   // Flips never remove an edge of the surface mesh (present or not), hence
   // never a recovered edge or triangle.
   FlipRecovery flips(dt.editor(), [&surf](VertId a, VertId b) { return surf.exists(a, b); });
-  auto split_and_insert = [&](VertId a, VertId b) {
-    const VertId p = surf.split(a, b, st);
+  auto split_and_insert = [&](VertId a, VertId b, int only_face = 0) {
+    const VertId p = surf.split(a, b, st, only_face);
     // Any flip, even one of a failed attempt, ends Delaunay insertion's
     // assumption that cavities are star-shaped.
     if (flips.stats().face_swaps + flips.stats().edge_removals != 0) dt.set_non_delaunay();
@@ -248,6 +283,13 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   // from triangles coarser than a thin feature (two faces closer than the
   // chord error); splitting their longest edges on the model brings the
   // mesh to the surfaces, which do not cross, so a few rounds end it.
+  // Before them, a mesh edge two faces' meshes both run inside goes out of
+  // all but one of them, split on each such face: no region boundary can
+  // be a manifold through it.
+  for (const auto& [a, b, f] : surf.shared_chords()) {
+    last_face = f;
+    split_and_insert(a, b, f);
+  }
   std::vector<char> planar(static_cast<std::size_t>(model.count(2)) + 1, 0);
   for (int f = 1; f <= model.count(2); ++f) planar[f] = model.type({2, f}) == geom::ShapeType::kPlane;
   for (int round = 0;; ++round) {
