@@ -37,12 +37,6 @@ TEST(CliMesh, SurfaceMeshOfABuiltinIsWrittenClassifiedAndChecked) {
   EXPECT_EQ(run_cli("mesh builtin:cylinder --dim 2 -q -o " + dir + "/cyl.vtu").exit_code, 0);
 }
 
-// The final check of a volume mesh is the boundary's whole check, not only
-// the tets' validity. A chamfer 1e-6 wide (ten times the model tolerance)
-// is the known case where the surface mesher fails that way (see
-// Robustness/SmallEdges_e1em6): two faces' meshes share an edge that is no
-// model edge, every tet positive and conforming. It must be reported, with
-// exit code 1 (once the mesher handles it, this test needs another case).
 // A chamfer 1e-6 wide: the faces beside it both ran a mesh edge between two
 // of its corners, and the region boundary was not a manifold there (the
 // final check reported it INVALID, exit 1). Recovery now takes the edge out

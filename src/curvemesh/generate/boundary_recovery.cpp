@@ -278,18 +278,18 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
       throw GeometryError(fmt::format("face {}: Steiner point {} could not be inserted ({})", last_face, p,
                                       modify::to_string(r.refusal)));
   };
-  // Crossing triangles first: no tetrahedralization contains both, and
-  // splitting them only where they are missing would never end. They come
-  // from triangles coarser than a thin feature (two faces closer than the
-  // chord error); splitting their longest edges on the model brings the
-  // mesh to the surfaces, which do not cross, so a few rounds end it.
-  // Before them, a mesh edge two faces' meshes both run inside goes out of
-  // all but one of them, split on each such face: no region boundary can
-  // be a manifold through it.
+  // A mesh edge two faces' meshes both run inside goes out of all but one
+  // of them first, split on each such face: no region boundary can be a
+  // manifold through it.
   for (const auto& [a, b, f] : surf.shared_chords()) {
     last_face = f;
     split_and_insert(a, b, f);
   }
+  // Crossing triangles next: no tetrahedralization contains both, and
+  // splitting them only where they are missing would never end. They come
+  // from triangles coarser than a thin feature (two faces closer than the
+  // chord error); splitting their longest edges on the model brings the
+  // mesh to the surfaces, which do not cross, so a few rounds end it.
   std::vector<char> planar(static_cast<std::size_t>(model.count(2)) + 1, 0);
   for (int f = 1; f <= model.count(2); ++f) planar[f] = model.type({2, f}) == geom::ShapeType::kPlane;
   for (int round = 0;; ++round) {

@@ -242,7 +242,6 @@ std::vector<std::uint32_t> SizeOctree::leaf_octants() const {
 // stays balanced: the flag lasts across rounds.
 void SizeOctree::balance(std::vector<std::uint32_t> work) {
   const std::int64_t top = std::int64_t{1} << opt_.max_depth;
-  balanced_parent_.resize(octants_.size(), 0);
   while (!work.empty()) {
     const std::uint32_t leaf = work.back();
     work.pop_back();
