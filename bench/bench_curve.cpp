@@ -188,9 +188,11 @@ int main(int argc, char** argv) {
         so.hmax = h;
         so.curvature = cm::size::CurvatureRule::relative_deviation(kAlpha);
         const auto sf = cm::size::build_size_field(*model, so);
-        linear = cm::generate::mesh_volume(*model, *sf.field);
+        cm::generate::VolumeMeshStats vst;
+        linear = cm::generate::mesh_volume(*model, *sf.field, {}, &vst);
         cm::optimize::ImproveOptions io;
         io.model = model.get();
+        io.tips = vst.tips;
         cm::optimize::improve_quality(linear, io);
         const double s = now() - t0;
         linear_s = k == 0 ? s : std::min(linear_s, s);

@@ -110,9 +110,11 @@ int main(int argc, char** argv) {
             cm::size::SizeOptions so;
             so.hmax = hmax_arg;
             const auto sf = cm::size::build_size_field(*model, so);
-            auto m = cm::generate::mesh_volume(*model, *sf.field);
+            cm::generate::VolumeMeshStats vst;
+            auto m = cm::generate::mesh_volume(*model, *sf.field, {}, &vst);
             cm::optimize::ImproveOptions io;  // as `curvemesh mesh` does: boundary vertices move on the model
             io.model = model.get();
+            io.tips = vst.tips;
             cm::optimize::improve_quality(m, io);
             Row r;
             measure(m, r);

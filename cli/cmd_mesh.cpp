@@ -160,6 +160,7 @@ int run_volume(const MeshCliOptions& o) {
     // fresh mesh are mostly against the boundary, pinned there otherwise.
     optimize::ImproveOptions io;
     io.model = model;
+    io.tips = st.tips;
     // Deletions move the surface: within the chord rule the sizes asked for.
     if (so.curvature.kind == size::CurvatureRule::Kind::kRelativeDeviation) io.chord_alpha = so.curvature.value;
     opt = optimize::improve_quality(m, io);

@@ -90,7 +90,7 @@ void add_model_flags(CLI::App* cmd, ModelFlags& f) {
 
 void add_size_flags(CLI::App* cmd, SizeFlags& f) {
   cmd->add_option("--hmax", f.hmax, "Largest size (default: bounding-box diagonal / 20)")->check(CLI::PositiveNumber);
-  cmd->add_option("--hmin", f.hmin, "Smallest size (default: hmax / 100)")->check(CLI::PositiveNumber);
+  cmd->add_option("--hmin", f.hmin, "Smallest size (default: hmax / 100; a face tapering to a cusp may go to a tenth of it)")->check(CLI::PositiveNumber);
   cmd->add_option("--hgrad", f.hgrad, "Gradation: sizes grow at most by (hgrad-1) per unit length")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 1e6));

@@ -77,35 +77,38 @@ TEST(EdgeMesh, CircleGetsEqualSegmentsFromTheIntegral) {
   EXPECT_EQ(generate::discretize_edge(*cyl, circle, huge, {}, 3).params.size(), 4u);
 }
 
-// At a cusp the first segment gets kCuspStretch times the others' length,
-// the count unchanged.
-TEST(EdgeMesh, CuspEndsGetALongerSegment) {
+// A tip radius puts the end's first node at that chord distance from it
+// and leaves the metric to place the others beyond.
+TEST(EdgeMesh, TipRadiusPlacesTheFirstNode) {
   const auto cyl = geom::make_analytic_cylinder(Vec3::Zero(), Vec3::UnitZ(), 2, 1);
   const size::UniformSizeField h(0.1);
-  int circle = 0;
+  int line = 0;
   for (int e = 1; e <= cyl->count(1); ++e)
-    if (cyl->type({1, e}) == geom::ShapeType::kCircle) circle = e;
-  ASSERT_GT(circle, 0);
-  const auto plain = generate::discretize_edge(*cyl, circle, h, {});
-  const auto one = generate::discretize_edge(*cyl, circle, h, {}, 1, {true, false});
-  const auto both = generate::discretize_edge(*cyl, circle, h, {}, 1, {true, true});
-  ASSERT_EQ(one.params.size(), plain.params.size());
-  ASSERT_EQ(both.params.size(), plain.params.size());
-  const auto arc = [](const generate::EdgeMesh& m, std::size_t k) { return m.params[k + 1] - m.params[k]; };
-  const std::size_t n = plain.params.size() - 1;
-  EXPECT_NEAR(arc(one, 0) / arc(one, 1), generate::kCuspStretch, 1e-3);
-  EXPECT_NEAR(arc(one, n - 1) / arc(one, 1), 1, 1e-3);
-  EXPECT_NEAR(arc(both, 0) / arc(both, n / 2), generate::kCuspStretch, 1e-3);
-  EXPECT_NEAR(arc(both, n - 1) / arc(both, n / 2), generate::kCuspStretch, 1e-3);
-  // No two edges of a cylinder leave a vertex in the same direction.
-  for (const auto& ends : generate::cusp_ends(*cyl)) EXPECT_FALSE(ends[0] || ends[1]);
+    if (cyl->type({1, e}) == geom::ShapeType::kLine) line = e;
+  ASSERT_GT(line, 0);
+  const auto plain = generate::discretize_edge(*cyl, line, h, {});
+  const auto one = generate::discretize_edge(*cyl, line, h, {}, 1, {0.25, 0});
+  const auto both = generate::discretize_edge(*cyl, line, h, {}, 1, {0.25, 0.35});
+  const auto chord = [](const generate::EdgeMesh& m, std::size_t a, std::size_t b) {
+    return (m.points[a] - m.points[b]).norm();
+  };
+  EXPECT_NEAR(chord(one, 0, 1), 0.25, 1e-9);
+  EXPECT_NEAR(chord(both, 0, 1), 0.25, 1e-9);
+  EXPECT_NEAR(chord(both, both.points.size() - 1, both.points.size() - 2), 0.35, 1e-9);
+  // Beyond the tip nodes the segments are of the size again.
+  for (std::size_t k = 1; k + 2 < both.points.size(); ++k) EXPECT_NEAR(chord(both, k, k + 1), 0.1, 0.02);
+  EXPECT_EQ(plain.points.size(), 11u);  // the side line is 1 long
+  EXPECT_EQ(both.points.size(), 7u);    // 0.25, four of 0.1, 0.35
+  // A radius the edge never reaches is ignored.
+  const auto far = generate::discretize_edge(*cyl, line, h, {}, 1, {5, 0});
+  EXPECT_EQ(far.params, plain.params);
 }
 
 // The ends cusp_ends marks come in pairs: two edges leaving one vertex at
 // less than kCuspDegrees (t20_data.step has faces tapering to a point).
 TEST(EdgeMesh, CuspsArePairsOfTangentEdgesAtAVertex) {
   const auto m = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/t20_data.step");
-  const auto cusps = generate::cusp_ends(*m);
+  const auto cusps = geom::cusp_ends(*m);
   ASSERT_EQ(static_cast<int>(cusps.size()), m->count(1));
   const auto direction = [&](int e, int side) {
     const geom::ParamRange r = m->param_range({1, e});
@@ -121,7 +124,7 @@ TEST(EdgeMesh, CuspsArePairsOfTangentEdgesAtAVertex) {
       for (int f = 1; f <= m->count(1); ++f)
         for (int fs = 0; fs < 2; ++fs)
           if ((f != e || fs != side) && m->edge_vertices(f)[fs] == v && cusps[f - 1][fs] &&
-              direction(e, side).dot(direction(f, fs)) > std::cos(generate::kCuspDegrees * std::numbers::pi / 180))
+              direction(e, side).dot(direction(f, fs)) > std::cos(geom::kCuspDegrees * std::numbers::pi / 180))
             partner = true;
       EXPECT_TRUE(partner) << "edge " << e << " end " << side;
     }

@@ -89,8 +89,10 @@ mesh::TetMesh mesh_boundary(const geom::Model& model, const size::SizeField& siz
                             BoundaryMeshStats* stats) {
   BoundaryMeshStats st;
   Timer timer;
-  const std::vector<EdgeMesh> edges = discretize_edges(model, size, o.edges);
+  const std::vector<geom::CuspTip> tips = cusp_tips(model, size);
+  const std::vector<EdgeMesh> edges = discretize_edges(model, size, o.edges, tips);
   st.edges_seconds = timer.seconds();
+  st.cusp_tips = tips.size();
 
   mesh::TetMesh m;
   const int nv = model.count(0), ne = model.count(1), nf = model.count(2);
@@ -117,7 +119,19 @@ mesh::TetMesh mesh_boundary(const geom::Model& model, const size::SizeField& siz
   std::vector<FaceMesh> faces(nf);
   std::vector<std::vector<std::vector<BoundaryPoint>>> loops(nf);
   for (int f = 1; f <= nf; ++f) loops[f - 1] = face_loops(model, f, edges, nodes, m);
-  tbb::parallel_for(1, nf + 1, [&](int f) { faces[f - 1] = mesh_face(model, f, loops[f - 1], size, o.faces); });
+  // Each face keeps out of the tips at its own vertices.
+  std::vector<std::vector<geom::CuspTip>> face_tips(nf);
+  for (const geom::CuspTip& tip : tips) {
+    std::vector<int> at;
+    for (const int e : model.upward({0, tip.vertex}))
+      for (const int f : model.upward({1, e})) at.push_back(f);
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end()), at.end());
+    for (const int f : at) face_tips[f - 1].push_back(tip);
+  }
+  tbb::parallel_for(1, nf + 1, [&](int f) {
+    faces[f - 1] = mesh_face(model, f, loops[f - 1], size, o.faces, face_tips[f - 1]);
+  });
   st.faces_seconds = timer.seconds();
 
   timer.reset();

@@ -23,6 +23,7 @@ struct BoundaryMeshOptions {
 struct BoundaryMeshStats {
   double edges_seconds = 0, faces_seconds = 0, assembly_seconds = 0;
   std::size_t edge_segments = 0;
+  std::size_t cusp_tips = 0;  ///< vertices whose tip ball holds no other point (geom/cusps.hpp)
   int refinement_insertions = 0, flips = 0, smoothing_moves = 0;
 };
 

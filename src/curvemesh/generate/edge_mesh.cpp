@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numbers>
 
 #include <tbb/parallel_for.h>
 
@@ -66,7 +65,7 @@ Table integrate(const geom::Model& m, int edge, const size::SizeField& size, dou
 }  // namespace
 
 EdgeMesh discretize_edge(const geom::Model& m, int edge, const size::SizeField& size, const EdgeMeshOptions& o,
-                         int min_segments, std::array<bool, 2> cusp) {
+                         int min_segments, std::array<double, 2> tip_radius) {
   EdgeMesh out;
   out.edge = edge;
   out.vertices = m.edge_vertices(edge);
@@ -79,69 +78,52 @@ EdgeMesh discretize_edge(const geom::Model& m, int edge, const size::SizeField& 
     out.points = {p, p};
     return out;
   }
-  const Table t = integrate(m, edge, size, r.u0, r.u1, o);
+  // A tip's sphere takes the first node; the metric places the others
+  // between the two (or the edge's own) ends.
+  double ua = r.u0, ub = r.u1;
+  for (int side = 0; side < 2; ++side) {
+    if (!(tip_radius[side] > 0)) continue;
+    if (const auto u = geom::param_at_distance(m, edge, side, tip_radius[side])) (side == 0 ? ua : ub) = *u;
+  }
+  if (!(ua < ub)) {
+    ua = r.u0;
+    ub = r.u1;
+  }
+  const bool tip0 = ua > r.u0, tip1 = ub < r.u1;
+  const Table t = integrate(m, edge, size, ua, ub, o);
   out.metric_length = t.cum.back();
   int n = static_cast<int>(std::lround(out.metric_length));
   if (m.length(edge) < o.hmin) n = 1;
-  n = std::max({n, min_segments, 1});
-  out.params.resize(n + 1);
-  out.params.front() = r.u0;
-  out.params.back() = r.u1;
-  // Segment i spans the metric length L·(weights before i + its own)/total.
-  double first = 1, last = 1;
-  if (n >= 2) {
-    first = cusp[0] ? kCuspStretch : 1;
-    last = cusp[1] ? kCuspStretch : 1;
-    if (n / (n - 2 + first + last) < 0.8) first = last = 1;
-  }
-  const double total = n - 2 + first + last;
+  n = std::max({n, min_segments - int(tip0) - int(tip1), 1});
+  std::vector<double> inner(n + 1);
+  inner.front() = ua;
+  inner.back() = ub;
   std::size_t k = 1;
   for (int i = 1; i < n; ++i) {
-    const double target = out.metric_length * (first + (i - 1)) / total;
+    const double target = out.metric_length * i / n;
     while (k + 1 < t.cum.size() && t.cum[k] < target) ++k;
     // Linear in the table interval [k-1, k].
     const double c0 = t.cum[k - 1], c1 = t.cum[k];
     const double w = c1 > c0 ? std::clamp((target - c0) / (c1 - c0), 0.0, 1.0) : 0.5;
-    out.params[i] = t.u[k - 1] + w * (t.u[k] - t.u[k - 1]);
+    inner[i] = t.u[k - 1] + w * (t.u[k] - t.u[k - 1]);
   }
-  out.points.resize(n + 1);
-  for (int i = 0; i <= n; ++i) out.points[i] = m.edge_point(edge, out.params[i]);
+  if (tip0) out.params.push_back(r.u0);
+  out.params.insert(out.params.end(), inner.begin(), inner.end());
+  if (tip1) out.params.push_back(r.u1);
+  out.points.resize(out.params.size());
+  for (std::size_t i = 0; i < out.params.size(); ++i) out.points[i] = m.edge_point(edge, out.params[i]);
   // End points are the model vertices themselves, not the curve's ends.
   if (out.vertices[0] > 0) out.points.front() = m.vertex_point(out.vertices[0]);
   if (out.vertices[1] > 0) out.points.back() = m.vertex_point(out.vertices[1]);
   return out;
 }
 
-std::vector<std::array<bool, 2>> cusp_ends(const geom::Model& m) {
-  const int ne = m.count(1);
-  struct End {
-    int edge, side;
-    Vec3 direction;  // unit, leaving the vertex
-  };
-  std::vector<std::vector<End>> at(m.count(0) + 1);
-  for (int e = 1; e <= ne; ++e) {
-    if (m.is_degenerate(e)) continue;
-    const auto v = m.edge_vertices(e);
-    const geom::ParamRange r = m.param_range({1, e});
-    for (int side = 0; side < 2; ++side) {
-      if (v[side] <= 0) continue;
-      const Vec3 d = m.edge_derivatives(e, side == 0 ? r.u0 : r.u1).d1 * (side == 0 ? 1.0 : -1.0);
-      if (d.norm() > 0) at[v[side]].push_back({e, side, d.normalized()});
-    }
-  }
-  std::vector<std::array<bool, 2>> out(ne, {false, false});
-  const double cosine = std::cos(kCuspDegrees * std::numbers::pi / 180);
-  for (const auto& ends : at)
-    for (std::size_t i = 0; i < ends.size(); ++i)
-      for (std::size_t j = i + 1; j < ends.size(); ++j)
-        if (ends[i].direction.dot(ends[j].direction) > cosine) {
-          out[ends[i].edge - 1][ends[i].side] = true;
-          out[ends[j].edge - 1][ends[j].side] = true;
-        }
-  return out;
+std::vector<geom::CuspTip> cusp_tips(const geom::Model& m, const size::SizeField& size) {
+  return geom::cusp_tips(m, [&](const Vec3& x) { return kTipWidth * size.size(x); });
 }
 
-std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeField& size, const EdgeMeshOptions& o) {
+std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeField& size, const EdgeMeshOptions& o,
+                                       const std::vector<geom::CuspTip>& tips) {
   const int ne = m.count(1);
   // Edges joining the same two vertices need two segments each so that no
   // two mesh edges coincide.
@@ -151,7 +133,8 @@ std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeFie
     const auto v = m.edge_vertices(e);
     ++joining[{std::min(v[0], v[1]), std::max(v[0], v[1])}];
   }
-  const std::vector<std::array<bool, 2>> cusps = cusp_ends(m);
+  std::vector<double> tip_of(m.count(0) + 1, 0.0);
+  for (const geom::CuspTip& tip : tips) tip_of[tip.vertex] = tip.radius;
   std::vector<EdgeMesh> out(ne);
   tbb::parallel_for(1, ne + 1, [&](int e) {
     const auto v = m.edge_vertices(e);
@@ -162,7 +145,8 @@ std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeFie
                it != joining.end() && it->second > 1) {
       min_segments = 2;
     }
-    out[e - 1] = discretize_edge(m, e, size, o, min_segments, cusps[e - 1]);
+    out[e - 1] = discretize_edge(m, e, size, o, min_segments,
+                                 {v[0] > 0 ? tip_of[v[0]] : 0.0, v[1] > 0 ? tip_of[v[1]] : 0.0});
   });
   return out;
 }

@@ -12,16 +12,13 @@
 // k sits where the integral reaches k·L/n. The size field is queried with the
 // edge and parameter as hint, so curvature is evaluated at the node itself.
 //
-// Cusps: where two edges leave a model vertex tangent to each other (a face
-// tapering to a point between them), the width between them grows as the
-// square of the distance from the vertex, so the triangle at the tip has a
-// quality proportional to the length of its two edges there. The segment
-// at such an end gets kCuspStretch times the metric length of the others
-// (when the others keep at least 0.8 of the mean): a better tip triangle
-// and the same count.
+// Cusp tips (geom/cusps.hpp): an edge with an end at a tip vertex gets its
+// first node there on the tip's sphere, and the metric places the others
+// from that node on.
 #include <array>
 #include <vector>
 
+#include "curvemesh/geom/cusps.hpp"
 #include "curvemesh/geom/model.hpp"
 #include "curvemesh/size/size_field.hpp"
 
@@ -33,7 +30,7 @@ struct EdgeMesh {
   bool degenerate = false;            ///< a pole: all nodes at one point
   std::vector<double> params;         ///< increasing, params.front() = u0, params.back() = u1
   std::vector<Vec3> points;           ///< on the edge at params
-  double metric_length = 0;           ///< L above
+  double metric_length = 0;           ///< L above, between the tip nodes if any
 };
 
 struct EdgeMeshOptions {
@@ -42,20 +39,23 @@ struct EdgeMeshOptions {
   double table_tolerance = 0.05;  ///< metric length per table interval at most this
 };
 
-inline constexpr double kCuspStretch = 1.25;
-/// Two edges leaving a vertex at less than this angle form a cusp.
-inline constexpr double kCuspDegrees = 10;
+/// A tip ends where the strip between its cusp edges is this times the
+/// local size wide: its cross edges are then about the size, and the
+/// triangles along it fair.
+inline constexpr double kTipWidth = 0.9;
 
 /// One edge. `min_segments` >= 1 (see above for how the caller chooses it);
-/// `cusp` marks the ends (at u0, at u1) that are cusps.
+/// `tip_radius` (at u0, at u1; 0: none) puts the first node at that chord
+/// distance from the end, if the edge gets that far from it.
 EdgeMesh discretize_edge(const geom::Model& model, int edge, const size::SizeField& size,
-                         const EdgeMeshOptions& options, int min_segments = 1, std::array<bool, 2> cusp = {});
+                         const EdgeMeshOptions& options, int min_segments = 1, std::array<double, 2> tip_radius = {});
 
-/// Per edge (index edge - 1), which of its ends are cusps (see above).
-std::vector<std::array<bool, 2>> cusp_ends(const geom::Model& model);
+/// The model's cusp tips for this size field: each ends where the strip
+/// between its edges is kTipWidth times the size wide.
+std::vector<geom::CuspTip> cusp_tips(const geom::Model& model, const size::SizeField& size);
 
 /// Every edge of the model, in parallel; result[e - 1] is edge e.
 std::vector<EdgeMesh> discretize_edges(const geom::Model& model, const size::SizeField& size,
-                                       const EdgeMeshOptions& options);
+                                       const EdgeMeshOptions& options, const std::vector<geom::CuspTip>& tips = {});
 
 }  // namespace cm::generate

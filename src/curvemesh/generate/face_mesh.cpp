@@ -87,8 +87,10 @@ constexpr double kNearFold = 0.17;  // cos 80°: see FaceMesher::folds
 
 class FaceMesher {
  public:
-  FaceMesher(const geom::Model& m, int face, const size::SizeField& size, const FaceMeshOptions& o)
-      : m_(m), face_(face), size_(size), o_(o), scale_(face_scaling(m, face)), accepted_(0.5 * o.max_edge) {}
+  FaceMesher(const geom::Model& m, int face, const size::SizeField& size, const FaceMeshOptions& o,
+             const std::vector<geom::CuspTip>& tips)
+      : m_(m), face_(face), size_(size), o_(o), tip_list_(tips), tips_(tips), scale_(face_scaling(m, face)),
+        accepted_(0.5 * o.max_edge) {}
 
   FaceMesh run(const std::vector<std::vector<BoundaryPoint>>& loops) {
     CdtInput in;
@@ -109,6 +111,10 @@ class FaceMesher {
       throw GeometryError(fmt::format("face {}: its boundary cannot be triangulated in (u, v): {}", face_, e.what()));
     }
     for (std::size_t i = 0; i < xyz_.size(); ++i) h_.push_back(size_at(i));
+    tip_of_.assign(out_.num_boundary, -1);
+    for (std::size_t i = 0; i < tip_of_.size(); ++i)
+      for (std::size_t k = 0; k < tip_list_.size(); ++k)
+        if (xyz_[i] == tip_list_[k].point) tip_of_[i] = static_cast<int>(k);
     // Plane Delaunay -> surface Delaunay -> refinement -> what it left ->
     // validity -> quality -> validity under the exact fold test.
     std::vector<std::pair<int, int>> edges;
@@ -140,6 +146,9 @@ class FaceMesher {
   static constexpr double kValenceFloor = 0.6;
 
   bool alive(std::size_t t) const { return t_.tris[t][0] >= 0; }
+
+  // Inside a cusp tip's ball, which keeps no point but its vertex.
+  bool in_tip(const Vec3& x) const { return tips_.contains(x); }
 
   double size_at(std::size_t i) const { return size_.size(xyz_[i], {{2, face_}, uv_[i]}); }
 
@@ -267,6 +276,7 @@ class FaceMesher {
   // face is narrower than the size it falls outside the face or onto the
   // far side, so t's circumcentre, else its centroid, is tried instead.
   bool insert_frontal(int t, int i, std::vector<int>& fan) {
+    if (tip_corner(t) >= 0) return split_shell(t, fan);
     const auto& p = t_.points;
     const auto tv = t_.tris[t];
     const int a = tv[Triangulation2d::next(i)], b = tv[Triangulation2d::prev(i)];
@@ -286,6 +296,51 @@ class FaceMesher {
     const double along = q > 0 ? std::min(kHalfSqrt3, q) : std::min(kHalfSqrt3, 0.5 * (std::sqrt(r2) + q));
     if (along > 0 && insert_metric(mid + along * n, t, surface, fan) >= 0) return true;
     return insert_metric(centre, t, surface, fan) >= 0 || insert_metric(centroid, t, surface, fan) >= 0;
+  }
+
+  bool is_tip_vertex(int v) const {
+    return static_cast<std::size_t>(v) < tip_of_.size() && tip_of_[static_cast<std::size_t>(v)] >= 0;
+  }
+
+  // The corner of t that is a cusp tip's vertex, or -1.
+  int tip_corner(int t) const {
+    for (int k = 0; k < 3; ++k)
+      if (is_tip_vertex(t_.tris[t][k])) return k;
+    return -1;
+  }
+
+  // A triangle of a tip's fan (its corner at the tip's vertex, the ball
+  // holding no point) gets a point only on the sphere's trace it spans:
+  // where the ray from the vertex through the middle of its far edge leaves
+  // the ball, so the fan gets more, narrower needles while that edge is
+  // longer than max_edge sizes. On the sphere, not beyond: the triangle's
+  // circumcircle passes through the vertex, the sphere's centre, so it
+  // holds the sphere's arc between the far edge's ends, and the point's
+  // cavity takes the triangle.
+  bool split_shell(int t, std::vector<int>& fan) {
+    const int k = tip_corner(t);
+    const auto tv = t_.tris[t];
+    const int v = tv[k], a = tv[Triangulation2d::next(k)], b = tv[Triangulation2d::prev(k)];
+    if ((xyz_[a] - xyz_[b]).norm() <= o_.max_edge * 0.5 * (h_[a] + h_[b])) return false;
+    const geom::CuspTip& tip = tip_list_[tip_of_[v]];
+    const Vec2 origin = t_.points[v], ray = 0.5 * (t_.points[a] + t_.points[b]) - origin;
+    const double target = tip.radius;
+    const auto reach = [&](double s) {
+      return (m_.face_point(face_, scale_.to_uv(origin + s * ray)) - tip.point).norm();
+    };
+    double lo = 1, hi = 1;
+    if (reach(1) < target) {
+      for (hi = 1.25; hi < 4 && reach(hi) < target; hi *= 1.25) lo = hi;
+      if (!(reach(hi) >= target)) return false;
+      for (int it = 0; it < 30; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (reach(mid) < target ? lo : hi) = mid;
+      }
+    }
+    const Vec2 x = origin + hi * ray;
+    Metric2 m = surface_metric(x);
+    if (!m.positive()) m = Metric2{};
+    return insert_metric(x, t, m, fan) >= 0;
   }
 
   // Inserts plane point x by a Bowyer–Watson cavity grown from the triangle
@@ -321,10 +376,12 @@ class FaceMesher {
     if (seed != loc.tri && in_circle(seed)) grow(seed);
     const Vec2 uv = scale_.to_uv(x);
     const geom::SurfaceDerivatives d = m_.face_derivatives(face_, uv);
-    if (crowding)
+    if (crowding) {
+      if (in_tip(d.point)) return -1;
       for (const int t : cavity_)
         for (const int v : t_.tris[t])
           if ((d.point - xyz_[v]).norm() < kCrowded * h_[v]) return -1;
+    }
     int id = t_.insert_in_cavity(x, cavity_, &fan);
     if (id < 0) {
       if (loc.kind == Location::kOnEdge && t_.is_constrained(loc.tri, loc.index)) return -1;
@@ -375,6 +432,10 @@ class FaceMesher {
       for (const Candidate& c : cands) {
         if (uv_.size() >= o_.max_points) break;
         if (!alive(c.tri) || t_.tris[c.tri] != c.verts) continue;  // changed by an earlier insertion
+        if (tip_corner(c.tri) >= 0) {
+          if (split_shell(c.tri, fan)) ++inserted;
+          continue;
+        }
         const auto& p = t_.points;
         const Vec2 centroid = (p[c.verts[0]] + p[c.verts[1]] + p[c.verts[2]]) / 3;
         Metric2 m = surface_metric(centroid);
@@ -510,7 +571,9 @@ class FaceMesher {
   // lower-numbered triangle: edge b-c of t = (a, b, c) and
   // u = (d, c, b) is flipped to (a, b, d), (d, c, a) when decide(a, b, c, d)
   // says so (decide may record the flip it accepts). Each triangle flips at
-  // most once per sweep; its other edges are seen on the next one.
+  // most once per sweep; its other edges are seen on the next one. The
+  // spokes of a tip's fan stay: its needles are poor by any triangle
+  // measure, and what a flip would make of them is worse (a cap).
   template <class Decide>
   int flip_where(Decide decide) {
     int flips = 0;
@@ -522,6 +585,7 @@ class FaceMesher {
         const auto tv = t_.tris[t];
         const int a = tv[i], b = tv[Triangulation2d::next(i)], c = tv[Triangulation2d::prev(i)];
         const int d = t_.tris[u][t_.mirror(static_cast<int>(t), i)];
+        if (is_tip_vertex(b) || is_tip_vertex(c)) continue;
         if (decide(a, b, c, d)) {
           t_.flip(static_cast<int>(t), i);
           ++flips;
@@ -654,6 +718,8 @@ class FaceMesher {
       const int* first = ball.data() + ball_start[v];
       const int* last = ball.data() + ball_start[v + 1];
       if (first == last) continue;
+      // A tip's fan keeps its far points where they went in, on the sphere.
+      if (std::any_of(first, last, [&](int t) { return tip_corner(t) >= 0; })) continue;
       const auto ball_quality = [&](double* worst) {
         double sum = 0;
         *worst = 1;
@@ -693,9 +759,11 @@ class FaceMesher {
       const auto old_tangent = tangent_[v];
       const auto try_move = [&](const Vec2& to) {
         if (!to.allFinite()) return false;
+        const Vec2 to_uv = scale_.to_uv(to);
+        const geom::SurfaceDerivatives d = m_.face_derivatives(face_, to_uv);
+        if (in_tip(d.point)) return false;
         t_.points[v] = to;
-        uv_[v] = scale_.to_uv(to);
-        const geom::SurfaceDerivatives d = m_.face_derivatives(face_, uv_[v]);
+        uv_[v] = to_uv;
         xyz_[v] = d.point;
         normal_[v] = surface_normal(d);
         tangent_[v] = {d.du / scale_.su, d.dv / scale_.sv};
@@ -770,6 +838,9 @@ class FaceMesher {
   int face_;
   const size::SizeField& size_;
   const FaceMeshOptions& o_;
+  const std::vector<geom::CuspTip>& tip_list_;
+  geom::TipBalls tips_;
+  std::vector<int> tip_of_;  // per boundary point (only those can be): the tip it is the vertex of, or -1
   Scaling scale_;
   // A triangle whose 3D circumradius is under this many local sizes has all
   // its edges under max_edge sizes: it needs no point.
@@ -793,8 +864,9 @@ class FaceMesher {
 }  // namespace
 
 FaceMesh mesh_face(const geom::Model& model, int face, const std::vector<std::vector<BoundaryPoint>>& loops,
-                   const size::SizeField& size, const FaceMeshOptions& options) {
-  return FaceMesher(model, face, size, options).run(loops);
+                   const size::SizeField& size, const FaceMeshOptions& options,
+                   const std::vector<geom::CuspTip>& tips) {
+  return FaceMesher(model, face, size, options, tips).run(loops);
 }
 
 }  // namespace cm::generate

@@ -31,6 +31,7 @@
 // vanish from the surface mesh; they count as neither good nor bad.
 #include <vector>
 
+#include "curvemesh/geom/cusps.hpp"
 #include "curvemesh/geom/model.hpp"
 #include "curvemesh/size/size_field.hpp"
 
@@ -64,7 +65,10 @@ struct FaceMesh {
 
 /// Throws cm::GeometryError naming the face when its boundary cannot be
 /// triangulated in (u, v) (self-intersecting p-curves, coincident points).
+/// No interior point goes inside the balls of `tips` (those at the face's
+/// vertices; see geom/cusps.hpp), except to unfold a triangle.
 FaceMesh mesh_face(const geom::Model& model, int face, const std::vector<std::vector<BoundaryPoint>>& loops,
-                   const size::SizeField& size, const FaceMeshOptions& options);
+                   const size::SizeField& size, const FaceMeshOptions& options,
+                   const std::vector<geom::CuspTip>& tips = {});
 
 }  // namespace cm::generate

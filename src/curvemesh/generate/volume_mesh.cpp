@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <map>
+#include <numbers>
+#include <optional>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -151,6 +153,52 @@ Vec3 circumcentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return a + (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u) + w.squaredNorm() * u.cross(v)) / det;
 }
 
+// A tet of a cusp tip's fan (a corner at the tip's vertex; the ball holds
+// no other point) is refined on the sphere instead of at its circumcentre,
+// which lies inside the ball: its far face is a triangle of the fan's cap,
+// and the cap is refined as a surface, Delaunay refinement on the sphere,
+// while that face's circumradius is over the size or over √2 its shortest
+// edge (angles under 20°) and half the size. The point is the face's circumcentre taken to
+// the sphere along the ray from the vertex, then, if that one is refused,
+// its centroid likewise. On the sphere, not beyond it: the tet's
+// circumsphere passes through the sphere's centre, so it holds the cap of
+// the sphere over the far face, and the point's cavity takes the tet.
+// Empty for any other tet. `h` gets the far face's size (the mean of its
+// vertices'), the one its points are judged by: the tip's vertex has its
+// own, larger, from the ball around it.
+std::vector<Vec3> shell_points(const mesh::TetMesh& m, const std::array<VertId, 4>& tv,
+                               const std::map<VertId, const geom::CuspTip*>& tip_of, const std::vector<double>& vh,
+                               double* h_face) {
+  for (int k = 0; k < 4; ++k) {
+    const auto it = tip_of.find(tv[k]);
+    if (it == tip_of.end()) continue;
+    const geom::CuspTip& tip = *it->second;
+    std::array<Vec3, 3> f;
+    double h = 0;
+    for (int i = 0, j = 0; i < 4; ++i)
+      if (i != k) {
+        f[j++] = m.coords[tv[i]];
+        h += vh[tv[i]] / 3;
+      }
+    const Vec3 u = f[1] - f[0], v = f[2] - f[0], n = u.cross(v);
+    if (!(n.squaredNorm() > 0)) return {};
+    const Vec3 centre = f[0] + (u.squaredNorm() * v.cross(n) + v.squaredNorm() * n.cross(u)) / (2 * n.squaredNorm());
+    const double radius = (centre - f[0]).norm();
+    const double shortest = std::min({u.norm(), v.norm(), (f[2] - f[1]).norm()});
+    // Poor shapes are refined only while the circumradius is over half the
+    // size: the new point is that far from every other, so this ends.
+    if (radius <= h && (radius <= std::numbers::sqrt2 * shortest || radius <= 0.5 * h)) return {};
+    *h_face = h;
+    std::vector<Vec3> out;
+    for (const Vec3& c : {centre, Vec3((f[0] + f[1] + f[2]) / 3)}) {
+      const Vec3 ray = c - tip.point;
+      if (ray.norm() > 0) out.push_back(tip.point + ray * (tip.radius / ray.norm()));
+    }
+    return out;
+  }
+  return {};
+}
+
 // Delaunay refinement to the size field: circumcentres of tets too large for
 // the size are inserted (never across a boundary face), in sweeps. Each sweep
 // collects the circumcentres of the bad tets among those created by the
@@ -161,9 +209,16 @@ Vec3 circumcentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 // crowding. The size of a tet is the mean of its vertices' sizes, each
 // queried once, rather than a size-field query per tet tested (about seven
 // per point inserted).
-void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMeshOptions& o, VolumeMeshStats& st) {
+void refine_interior(const size::SizeField& size, const std::vector<geom::CuspTip>& tip_list, Delaunay3d& dt,
+                     const VolumeMeshOptions& o, VolumeMeshStats& st) {
   auto& m = dt.mesh();
   auto& ed = dt.editor();
+  const geom::TipBalls tips(tip_list);
+  std::map<VertId, const geom::CuspTip*> tip_of;
+  for (VertId v = 0; v < m.coords.size(); ++v)
+    if (m.vert_class[v].dim == 0)
+      for (const geom::CuspTip& tip : tip_list)
+        if (tip.vertex == m.vert_class[v].tag) tip_of[v] = &tip;
   std::vector<double> vh(m.coords.size(), INFINITY);
   tbb::parallel_for(VertId{0}, static_cast<VertId>(m.coords.size()), [&](VertId v) {
     if (!dt.is_far(v)) vh[v] = size.size(m.coords[v]);
@@ -182,6 +237,9 @@ void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMe
   };
   std::vector<Candidate> candidates;
   std::vector<Vec3> centres;
+  // A bound on the points the tips' caps take, whatever their geometry.
+  constexpr std::size_t kMaxShellPoints = 100'000;
+  std::size_t shell_inserted = 0;
   while (!queue.empty()) {
     candidates.clear();
     for (TetId t : queue) {
@@ -198,13 +256,42 @@ void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMe
     for (const std::uint32_t i : brio_order(centres)) {
       const Candidate& c = candidates[i];
       if (ed.is_dead(c.tet) || m.tet2verts[c.tet] != c.verts) continue;
-      TetId home;
-      try {
-        home = dt.locate(c.centre, c.tet);
-      } catch (const std::domain_error&) {
-        continue;
+      // The point, and where it goes: the circumcentre, or in a cusp tip's
+      // fan the first of its shell points that lands in the tet's region.
+      Vec3 x = c.centre;
+      double h = c.h;
+      TetId home = kNone;
+      if (tips.contains(x)) {
+        for (const Vec3& y : shell_points(m, c.verts, tip_of, vh, &h)) {
+          try {
+            const TetId at = dt.locate(y, c.tet);
+            if (m.tet_region[at] != m.tet_region[c.tet] || m.tet_region[at] == 0) continue;
+            // Never nearer than half the face's size to a point around it:
+            // the cap's vertices are not all on the sphere, so a projected
+            // centre can land next to one, and refinement must end.
+            bool crowded = false;
+            for (const TetId near : {at, c.tet})
+              for (const VertId w : m.tet2verts[near])
+                crowded = crowded || (m.coords[w] - y).norm() < 0.5 * h;
+            if (crowded) continue;
+            x = y;
+            home = at;
+            break;
+          } catch (const std::domain_error&) {
+          }
+        }
+        if (home == kNone || ++shell_inserted > kMaxShellPoints) {
+          ++st.refused_points;
+          continue;
+        }
+      } else {
+        try {
+          home = dt.locate(x, c.tet);
+        } catch (const std::domain_error&) {
+          continue;
+        }
+        if (m.tet_region[home] != m.tet_region[c.tet] || m.tet_region[home] == 0) continue;
       }
-      if (m.tet_region[home] != m.tet_region[c.tet] || m.tet_region[home] == 0) continue;
       // Too close to the boundary: the new tets against it would be flat.
       bool close = false;
       for (int f = 0; f < 4 && !close; ++f) {
@@ -213,16 +300,16 @@ void refine_interior(const size::SizeField& size, Delaunay3d& dt, const VolumeMe
         const auto& fv = mesh::kFaceVerts[f];
         const std::array<VertId, 3> face{hv[fv[0]], hv[fv[1]], hv[fv[2]]};
         const Vec3 n = (m.coords[face[1]] - m.coords[face[0]]).cross(m.coords[face[2]] - m.coords[face[0]]);
-        close = std::abs(n.normalized().dot(c.centre - m.coords[face[0]])) < o.boundary_clearance * c.h;
+        close = std::abs(n.normalized().dot(x - m.coords[face[0]])) < o.boundary_clearance * h;
       }
       if (close) {
         ++st.refused_points;
         continue;
       }
-      const VertId p = m.add_vert(c.centre);
+      const VertId p = m.add_vert(x);
       m.resize_vertex_arrays();
       m.vert_class[p] = {3, m.tet_region[home]};
-      vh.push_back(size.size(c.centre));
+      vh.push_back(size.size(x));
       const auto res = dt.insert(p, home);
       if (res.refusal != modify::Refusal::kNone) {
         m.coords.pop_back();
@@ -304,7 +391,8 @@ mesh::TetMesh mesh_volume_from_boundary(const geom::Model& model, const size::Si
   st.outside_tets = remove_outside(dt);
   st.classify_seconds = step.seconds();
   step.reset();
-  if (o.refine) refine_interior(size, dt, o, st);
+  st.tips = cusp_tips(model, size);
+  if (o.refine) refine_interior(size, st.tips, dt, o, st);
   st.refine_seconds = step.seconds();
   dt.editor().compact();
   compact_vertices(m);

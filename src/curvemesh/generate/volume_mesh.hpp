@@ -8,6 +8,7 @@
 // with their region, every boundary vertex, edge and triangle classified on
 // the model with parameters, Steiner points on the model.
 #include <cstddef>
+#include <vector>
 
 #include "curvemesh/generate/boundary_mesh.hpp"
 #include "curvemesh/generate/boundary_recovery.hpp"
@@ -40,6 +41,9 @@ struct VolumeMeshStats {
   std::size_t interior_points = 0, refused_points = 0;
   std::size_t outside_tets = 0;
   std::size_t region_conflicts = 0;  ///< boundary faces whose side disagrees with their component's region
+  /// The cusp tips whose balls interior refinement kept empty (for the
+  /// optimizer: optimize::ImproveOptions::tips).
+  std::vector<geom::CuspTip> tips;
   double boundary_seconds = 0, delaunay_seconds = 0, recovery_seconds = 0, classify_seconds = 0,
          refine_seconds = 0;
 };

@@ -64,7 +64,12 @@ Summary summarize(const modify::MeshEditor& ed, double threshold) {
   return s;
 }
 
-bool needs_work(const mesh::TetMesh& m, TetId t, double q, const ImproveOptions& o) {
+// A needle of a cusp tip's fan (a corner at the tip's vertex) has a low
+// mean ratio by design: it is judged by its angles only.
+bool needs_work(const mesh::TetMesh& m, TetId t, double q, const ImproveOptions& o, const std::vector<char>& tip_vertex) {
+  if (!tip_vertex.empty())
+    for (const VertId v : m.tet2verts[t])
+      if (v < tip_vertex.size() && tip_vertex[v]) return min_dihedral(m, t) < o.dihedral_threshold;
   return q < o.threshold || min_dihedral(m, t) < o.dihedral_threshold;
 }
 
@@ -195,20 +200,51 @@ bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation&
   return is_progress(before.first, before.second, after.first, after.second);
 }
 
+// What the cusp tips forbid (ImproveOptions::tips): points inside their
+// balls, and moving or collapsing the boundary vertices next to a tip's
+// vertex. The two ends of the strip's first cross edge stay aligned, which
+// keeps the tip's needle from becoming a cap, and the faces' fans keep the
+// fine spacing at the strip that the needles there need (a better mean
+// ratio of the needles around asks for the opposite of both).
+struct TipRules {
+  geom::TipBalls balls;
+  std::vector<char> pinned_, tip_vertex;  // per vertex (empty: no tips)
+  bool pinned(VertId v) const { return v < pinned_.size() && pinned_[v]; }
+
+  TipRules(const mesh::TetMesh& m, const std::vector<geom::CuspTip>& tips) : balls(tips) {
+    if (tips.empty()) return;
+    pinned_.assign(m.coords.size(), 0);
+    tip_vertex.assign(m.coords.size(), 0);
+    std::vector<TetId> ball;
+    for (VertId v = 0; v < m.coords.size(); ++v) {
+      if (m.vert_class[v].dim != 0) continue;
+      const bool tip = std::any_of(tips.begin(), tips.end(), [&](const geom::CuspTip& c) { return c.vertex == m.vert_class[v].tag; });
+      if (!tip) continue;
+      tip_vertex[v] = 1;
+      mesh::collect_ball(m, v, ball);
+      for (const TetId t : ball)
+        for (const VertId w : m.tet2verts[t])
+          if (m.vert_class[w].dim == 1 || m.vert_class[w].dim == 2) pinned_[w] = 1;
+    }
+  }
+};
+
 // With a model, boundary vertices move too, on their model entity. The
 // Laplacian move first (cheap, and right for fair balls), else the search.
 bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::BoundaryIndex* boundary,
-                  const ImproveOptions& o, bool search, TetId t, ImproveStats& st, std::vector<TetId>& ball) {
+                  const ImproveOptions& o, const TipRules& tips, bool search, TetId t, ImproveStats& st,
+                  std::vector<TetId>& ball) {
   bool moved = false;
   auto& m = ed.mesh();
   const auto tv = m.tet2verts[t];
   for (VertId v : tv) {
+    if (tips.pinned(v)) continue;
     auto r = o.model ? modify::plan_relocation(ed, cav, *boundary, v, o.model) : modify::plan_relocation(ed, cav, v);
     bool searched = false;
-    if (!relocation_progresses(m, v, r, ball)) {
+    if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball)) {
       if (!search) continue;
       r = plan_searched_relocation(ed, cav, boundary, v, o.model, o.dihedral_threshold);
-      if (!relocation_progresses(m, v, r, ball)) continue;
+      if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball)) continue;
       searched = true;
     }
     modify::apply(ed, cav, v, r);
@@ -254,7 +290,7 @@ bool try_delete(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryInd
 // triangle at a sharp corner of a face can lengthen until it is no longer
 // thin.
 bool try_collapse(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryIndex& boundary,
-                  const geom::Model* model, TetId t, ImproveStats& st) {
+                  const geom::Model* model, const TipRules& tips, TetId t, ImproveStats& st) {
   auto& m = ed.mesh();
   const auto tv = m.tet2verts[t];
   int best = -1;
@@ -263,6 +299,7 @@ bool try_collapse(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryI
     const auto& e = mesh::kTetEdges[static_cast<std::size_t>(k % 6)];
     const VertId from = tv[static_cast<std::size_t>(k < 6 ? e[0] : e[1])], to = tv[static_cast<std::size_t>(k < 6 ? e[1] : e[0])];
     if (m.vert_class[from].dim != 3 && !model) continue;
+    if (tips.pinned(from)) continue;
     const auto plan = modify::plan_collapse(ed, cav, boundary, from, to, model);
     if (plan.refusal != modify::Refusal::kNone) continue;
     const auto before = worst_of(m, cav.tets());
@@ -290,14 +327,14 @@ bool try_collapse(modify::MeshEditor& ed, modify::Cavity& cav, modify::BoundaryI
 
 // The best point insertion for t: in the shell of one of its six edges,
 // else in its neighbourhood one or two face steps deep.
-bool try_insert(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, ImproveStats& st) {
+bool try_insert(modify::MeshEditor& ed, modify::Cavity& cav, const TipRules& tips, TetId t, ImproveStats& st) {
   const auto tv = ed.mesh().tet2verts[t];
   int best = -1;
   double best_after = 0;
   for (int e = 0; e < 8; ++e) {
     const auto p = e < 6 ? plan_shell_insertion(ed, cav, tv[mesh::kTetEdges[e][0]], tv[mesh::kTetEdges[e][1]], t)
                          : plan_ball_insertion(ed, cav, t, e - 5);
-    if (p.refusal == modify::Refusal::kNone && p.after > best_after) {
+    if (p.refusal == modify::Refusal::kNone && p.after > best_after && !tips.balls.contains(p.point)) {
       best = e;
       best_after = p.after;
     }
@@ -320,6 +357,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
   // Model-aware relocation reads it, element deletion edits it.
   std::unique_ptr<modify::BoundaryIndex> boundary = std::make_unique<modify::BoundaryIndex>(m);
   modify::Cavity cav;
+  const TipRules tips(m, o.tips);
   const Summary before = summarize(ed, o.threshold);
   st.min_before = before.min;
   st.mean_before = before.mean;
@@ -366,7 +404,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
                           if (ed.is_dead(t)) continue;
                           // Worst angle-aware shape first: slivers before
                           // fair-angled tets of the same mean ratio.
-                          if (needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o)) badness[i] = shape(m, t);
+                          if (needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o, tips.tip_vertex)) badness[i] = shape(m, t);
                         }
                       });
     for (std::size_t i = 0; i < candidates.size(); ++i)
@@ -389,7 +427,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
     }
     std::size_t changes = 0;
     for (const auto& [q0, t] : bad) {
-      if (ed.is_dead(t) || !needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o)) continue;
+      if (ed.is_dead(t) || !needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o, tips.tip_vertex)) continue;
       if (o.deletion && o.model) {
         Timer op;
         const bool done = try_delete(ed, cav, *boundary, o, t, st, touched);
@@ -410,7 +448,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
       }
       if (o.relocation) {
         Timer op;
-        const bool moved = try_relocate(ed, cav, boundary.get(), o, stuck && o.search, t, st, ball);
+        const bool moved = try_relocate(ed, cav, boundary.get(), o, tips, stuck && o.search, t, st, ball);
         st.relocation_seconds += op.seconds();
         if (moved) {
           ++changes;
@@ -419,7 +457,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
       }
       if (o.collapse && stuck) {
         Timer op;
-        const bool done = try_collapse(ed, cav, *boundary, o.model, t, st);
+        const bool done = try_collapse(ed, cav, *boundary, o.model, tips, t, st);
         st.collapse_seconds += op.seconds();
         if (done) {
           ++changes;
@@ -428,7 +466,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
       }
       if (o.insertion) {
         Timer op;
-        changes += try_insert(ed, cav, t, st);
+        changes += try_insert(ed, cav, tips, t, st);
         st.insertion_seconds += op.seconds();
       }
     }

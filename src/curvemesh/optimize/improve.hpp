@@ -24,6 +24,7 @@
 // chord rule.
 #include <cstddef>
 
+#include "curvemesh/geom/cusps.hpp"
 #include "curvemesh/geom/model.hpp"
 #include "curvemesh/mesh/tet_mesh.hpp"
 
@@ -55,6 +56,11 @@ struct ImproveOptions {
   bool collapse = true;
   /// The CAD model of the mesh, or nullptr (boundary vertices fixed).
   const geom::Model* model = nullptr;
+  /// Cusp tips the mesh was generated with (geom/cusps.hpp): no vertex is
+  /// moved or inserted inside their balls, and the boundary vertices next
+  /// to a tip's vertex (on its sphere) neither move nor collapse, so the
+  /// needles at the tip keep their fair bases.
+  std::vector<geom::CuspTip> tips;
 };
 
 struct ImproveStats {

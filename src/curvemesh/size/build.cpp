@@ -144,12 +144,18 @@ SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& o)
     std::vector<std::vector<SizeSample>> per(nf);
     tbb::parallel_for(1, nf + 1, [&](int f) { per[f - 1] = sample_face_proximity(model, f, r.hmin, r.hmax); });
     for (const auto& v : per) r.samples.insert(r.samples.end(), v.begin(), v.end());
+    const double hmin = r.hmin;
+    for (const geom::CuspTip& tip : geom::cusp_tips(model, [hmin](const Vec3&) { return hmin; })) {
+      const std::vector<SizeSample> strip = sample_cusp_strips(model, tip, kCuspStripFloor * r.hmin, r.hmax);
+      r.samples.insert(r.samples.end(), strip.begin(), strip.end());
+    }
   }
   r.sampling_seconds = timer.seconds();
 
   Timer octree_timer;
   OctreeOptions oo;
   oo.hmin = r.hmin;
+  oo.cusp_min = kCuspStripFloor * r.hmin;
   oo.hmax = r.hmax;
   oo.hgrad = o.hgrad;
   oo.max_depth = o.max_depth;
@@ -162,12 +168,12 @@ SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& o)
   r.octree->build();
   r.octree_seconds = octree_timer.seconds();
 
-  r.field = std::make_shared<ModelSizeField>(model, o, r.hmin, r.hmax, r.octree);
+  r.field = std::make_shared<ModelSizeField>(model, o, r.hmin, r.hmax, r.octree, oo.cusp_min);
   return r;
 }
 
 ModelSizeField::ModelSizeField(const geom::Model& model, const SizeOptions& o, double hmin, double hmax,
-                               std::shared_ptr<const SizeOctree> octree)
+                               std::shared_ptr<const SizeOctree> octree, double octree_min)
     : model_(model),
       octree_(std::move(octree)),
       metric_(o.metric),
@@ -175,6 +181,7 @@ ModelSizeField::ModelSizeField(const geom::Model& model, const SizeOptions& o, d
       directional_(o.directional && o.curvature.enabled()),
       hmin_(hmin),
       hmax_(hmax),
+      octree_min_(octree_min > 0 ? std::min(octree_min, hmin) : hmin),
       vertex_size_(model.count(0) + 1, std::numeric_limits<double>::infinity()),
       edge_size_(model.count(1) + 1, std::numeric_limits<double>::infinity()),
       face_size_(model.count(2) + 1, std::numeric_limits<double>::infinity()),
@@ -236,15 +243,19 @@ double ModelSizeField::hint_size(const SizeHint& hint) const {
   return h;
 }
 
+// The octree may hold cusp strip sizes below hmin (its own floor); every
+// other source is clamped to [hmin, hmax].
+double ModelSizeField::octree_size(const Vec3& x) const { return std::clamp(octree_->size(x), octree_min_, hmax_); }
+
 double ModelSizeField::size(const Vec3& x, const SizeHint& hint) const {
-  double h = std::min(octree_->size(x), hint_size(hint));
+  double h = hint_size(hint);
   if (metric_) h = std::min(h, metric_->size(x, hint));
-  return std::clamp(h, hmin_, hmax_);
+  return std::min(octree_size(x), std::clamp(h, hmin_, hmax_));
 }
 
 Metric ModelSizeField::metric(const Vec3& x, const SizeHint& hint) const {
   if (!anisotropic()) return isotropic_metric(size(x, hint));
-  Metric m = isotropic_metric(std::clamp(std::min(octree_->size(x), hint_size(hint)), hmin_, hmax_));
+  Metric m = isotropic_metric(std::min(octree_size(x), std::clamp(hint_size(hint), hmin_, hmax_)));
   if (directional_ && hint.entity.dim == 2 && hint.entity.tag >= 1 && hint.entity.tag <= model_.count(2) &&
       hint.param.allFinite()) {
     geom::Curvatures c;

@@ -61,21 +61,23 @@ struct SizeOptions {
 /// entity of its closure. The model must outlive the field.
 class ModelSizeField final : public SizeField {
  public:
+  /// `octree_min`: the octree's own floor (OctreeOptions::cusp_min; 0: hmin).
   ModelSizeField(const geom::Model& model, const SizeOptions& options, double hmin, double hmax,
-                 std::shared_ptr<const SizeOctree> octree);
+                 std::shared_ptr<const SizeOctree> octree, double octree_min = 0);
   double size(const Vec3& x, const SizeHint& hint = {}) const override;
   Metric metric(const Vec3& x, const SizeHint& hint = {}) const override;
   bool anisotropic() const override { return directional_ || (metric_ && metric_->anisotropic()); }
 
  private:
   double hint_size(const SizeHint& hint) const;
+  double octree_size(const Vec3& x) const;
 
   const geom::Model& model_;
   std::shared_ptr<const SizeOctree> octree_;
   std::shared_ptr<const SizeField> metric_;
   CurvatureRule rule_;
   bool directional_;
-  double hmin_, hmax_;
+  double hmin_, hmax_, octree_min_;
   // User sizes per tag (+inf: none), a region's included on its closure.
   std::vector<double> vertex_size_, edge_size_, face_size_, region_size_;
 };

@@ -183,8 +183,10 @@ void SizeOctree::insert(const Vec3& x, double h, SizeSource source) {
   if (built_) throw std::logic_error("size octree: insert after build()");
   if (!x.allFinite() || std::isnan(h) || !(h > 0))
     throw std::invalid_argument(fmt::format("size octree: bad request h = {} at ({}, {}, {})", h, x.x(), x.y(), x.z()));
-  if (h < opt_.hmin) {
-    h = opt_.hmin;
+  const double least = source == SizeSource::kCuspStrip && opt_.cusp_min > 0 ? std::min(opt_.cusp_min, opt_.hmin)
+                                                                              : opt_.hmin;
+  if (h < least) {
+    h = least;
     source = SizeSource::kHmin;
   }
   if (h >= opt_.hmax) return;  // the default already

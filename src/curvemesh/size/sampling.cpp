@@ -22,6 +22,7 @@ const char* to_string(SizeSource s) {
     case SizeSource::kHmin: return "hmin";
     case SizeSource::kShortEdge: return "short edge";
     case SizeSource::kProximity: return "narrow face";
+    case SizeSource::kCuspStrip: return "cusp strip";
   }
   return "?";
 }
@@ -352,6 +353,33 @@ std::vector<SizeSample> sample_face_proximity(const geom::Model& model, int face
         out.push_back({x, std::max(d, hmin), SizeSource::kProximity, {1, e}, Vec2(u, 0), 0, 0, Vec3::Zero()});
     }
   }
+  return out;
+}
+
+std::vector<SizeSample> sample_cusp_strips(const geom::Model& model, const geom::CuspTip& tip, double floor,
+                                           double hmax) {
+  std::vector<SizeSample> out;
+  constexpr int kMaxPerEdge = 4096;
+  for (const auto& pair : tip.pairs)
+    for (int k = 0; k < 2; ++k) {
+      const int e = pair[k], other = pair[1 - k];
+      const int side = model.edge_vertices(e)[0] == tip.vertex ? 0 : 1;
+      const std::optional<double> start = geom::param_at_distance(model, e, side, tip.radius);
+      if (!start) continue;
+      const geom::ParamRange r = model.param_range({1, e});
+      const double sense = side == 0 ? 1 : -1;
+      double u = *start;
+      for (int n = 0; n < kMaxPerEdge && u >= r.u0 && u <= r.u1; ++n) {
+        const geom::CurveDerivatives d = model.edge_derivatives(e, u);
+        const double w = model.closest_point({1, other}, d.point).distance;
+        if (!(w < hmax)) break;
+        const double h = std::max(w, floor);
+        out.push_back({d.point, h, SizeSource::kCuspStrip, {1, e}, Vec2(u, 0), 0, 0, Vec3::Zero()});
+        const double speed = d.d1.norm();
+        if (!(speed > 0)) break;
+        u += sense * 0.5 * h / speed;
+      }
+    }
   return out;
 }
 

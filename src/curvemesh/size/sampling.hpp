@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "curvemesh/geom/cusps.hpp"
 #include "curvemesh/geom/model.hpp"
 #include "curvemesh/size/curvature_size.hpp"
 
@@ -34,6 +35,7 @@ enum class SizeSource : int {
   kHmin = 6,            ///< clamped up to hmin
   kShortEdge = 7,       ///< a model edge shorter than the size around it
   kProximity = 8,       ///< two boundary edges of a narrow face close to each other
+  kCuspStrip = 9,       ///< the width of a face tapering to a cusp (may be below hmin)
 };
 const char* to_string(SizeSource s);
 
@@ -83,6 +85,17 @@ std::vector<SizeSample> sample_model_curvature(const geom::Model& model, const S
 /// vertex with it, where that distance is below hmax (so a strip between two
 /// nearly parallel edges gets elements as small as it is wide).
 std::vector<SizeSample> sample_face_proximity(const geom::Model& model, int face, double hmin, double hmax);
+
+/// Cusp strips (geom/cusps.hpp): points along each edge of the tip's pairs,
+/// from its sphere on, asking for the strip's width there (at least
+/// `floor`), spaced half that apart, until the strip is hmax wide. The tip
+/// itself asks for nothing: it will hold no point. Where the tip's ball is
+/// cut short by the model around it, the strip ends narrower than hmin, and
+/// the needles at the tip are fair only if the sizes there follow it down:
+/// these are the one request allowed below hmin, to kCuspStripFloor hmin.
+std::vector<SizeSample> sample_cusp_strips(const geom::Model& model, const geom::CuspTip& tip, double floor,
+                                           double hmax);
+inline constexpr double kCuspStripFloor = 0.1;
 
 /// Points covering a vertex, edge or face, or the boundary of a region (its
 /// faces and their edges), with spacing <= h/2 and at most

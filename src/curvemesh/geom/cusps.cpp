@@ -1,0 +1,162 @@
+#include "curvemesh/geom/cusps.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace cm::geom {
+
+namespace {
+
+struct End {
+  int edge, side;
+  Vec3 direction;  // unit, leaving the vertex
+};
+
+// The non-degenerate edge ends at each vertex (index: vertex tag).
+std::vector<std::vector<End>> ends_at_vertices(const Model& m) {
+  std::vector<std::vector<End>> at(m.count(0) + 1);
+  for (int e = 1; e <= m.count(1); ++e) {
+    if (m.is_degenerate(e)) continue;
+    const auto v = m.edge_vertices(e);
+    const ParamRange r = m.param_range({1, e});
+    for (int side = 0; side < 2; ++side) {
+      if (v[side] <= 0) continue;
+      const Vec3 d = m.edge_derivatives(e, side == 0 ? r.u0 : r.u1).d1 * (side == 0 ? 1.0 : -1.0);
+      if (d.norm() > 0) at[v[side]].push_back({e, side, d.normalized()});
+    }
+  }
+  return at;
+}
+
+bool is_cusp_pair(const End& a, const End& b) {
+  return a.direction.dot(b.direction) > std::cos(kCuspDegrees * std::numbers::pi / 180);
+}
+
+double param_from_end(const ParamRange& r, int side, double t) {
+  return side == 0 ? r.u0 + t * (r.u1 - r.u0) : r.u1 - t * (r.u1 - r.u0);
+}
+
+// Distance from the vertex, along edge a.edge, at which the strip between
+// it and edge b is `width` wide. The strip widens as the square of that
+// distance (or linearly for an angle), so the first half of the edge is
+// searched with steps that are fine near the vertex, then bisected. If it
+// never gets wide enough there, the half-way point: the caller's caps on R
+// are then what decide.
+double tip_length(const Model& m, const End& a, int other_edge, const Vec3& vertex,
+                  const std::function<double(const Vec3&)>& width) {
+  const ParamRange r = m.param_range({1, a.edge});
+  const auto point = [&](double t) { return m.edge_point(a.edge, param_from_end(r, a.side, t)); };
+  const auto wide = [&](double t) {
+    const Vec3 x = point(t);
+    return m.closest_point({1, other_edge}, x).distance >= width(x);
+  };
+  constexpr int kSteps = 32;
+  double narrow = 0;
+  for (int k = 1; k <= kSteps; ++k) {
+    double t = 0.5 * double(k) / kSteps;
+    t *= 2 * t;  // (k / kSteps)² / 2
+    if (!wide(t)) {
+      narrow = t;
+      continue;
+    }
+    double lo = narrow, hi = t;
+    for (int i = 0; i < 12; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (wide(mid) ? hi : lo) = mid;
+    }
+    return (point(hi) - vertex).norm();
+  }
+  return (point(0.5) - vertex).norm();
+}
+
+}  // namespace
+
+std::vector<std::array<bool, 2>> cusp_ends(const Model& m) {
+  std::vector<std::array<bool, 2>> out(m.count(1), {false, false});
+  for (const auto& ends : ends_at_vertices(m))
+    for (std::size_t i = 0; i < ends.size(); ++i)
+      for (std::size_t j = i + 1; j < ends.size(); ++j)
+        if (is_cusp_pair(ends[i], ends[j])) {
+          out[ends[i].edge - 1][ends[i].side] = true;
+          out[ends[j].edge - 1][ends[j].side] = true;
+        }
+  return out;
+}
+
+std::vector<CuspTip> cusp_tips(const Model& m, const std::function<double(const Vec3&)>& width) {
+  std::vector<CuspTip> out;
+  const auto at = ends_at_vertices(m);
+  for (int v = 1; v < static_cast<int>(at.size()); ++v) {
+    const std::vector<End>& ends = at[v];
+    const Vec3 p = m.vertex_point(v);
+    double radius = HUGE_VAL;
+    std::vector<std::array<int, 2>> pairs;
+    for (std::size_t i = 0; i < ends.size(); ++i)
+      for (std::size_t j = i + 1; j < ends.size(); ++j)
+        if (ends[i].edge != ends[j].edge && is_cusp_pair(ends[i], ends[j])) {
+          radius = std::min({radius, tip_length(m, ends[i], ends[j].edge, p, width),
+                             tip_length(m, ends[j], ends[i].edge, p, width)});
+          pairs.push_back({ends[i].edge, ends[j].edge});
+        }
+    // Two faces tapering at one vertex (two pairs) make a thin wedge of the
+    // solid itself there (the tips of t20_data.step's blades): the ball
+    // would hold no point across the wedge's thickness either, and its
+    // needles would span it. The strips there are meshed as any face.
+    if (radius == HUGE_VAL || pairs.size() != 1) continue;
+    std::vector<int> touching;  // faces at the vertex
+    for (const int e : m.upward({0, v})) {
+      if (!m.is_degenerate(e)) {
+        // Half-way along the edge, by parameter: a closed edge comes back
+        // to the vertex, so its length alone would not bound the ball.
+        const ParamRange r = m.param_range({1, e});
+        const double half_way = (m.edge_point(e, 0.5 * (r.u0 + r.u1)) - p).norm();
+        radius = std::min({radius, 0.4 * m.length(e), 0.8 * half_way});
+      }
+      for (const int f : m.upward({1, e})) touching.push_back(f);
+    }
+    std::sort(touching.begin(), touching.end());
+    for (int f = 1; f <= m.count(2); ++f) {
+      if (std::binary_search(touching.begin(), touching.end(), f)) continue;
+      const BoundingBox b = m.bounding_box({2, f});
+      const Vec3 gap = (b.min - p).cwiseMax(p - b.max).cwiseMax(0.0);
+      if (gap.norm() >= 1.25 * radius) continue;
+      radius = std::min(radius, 0.8 * m.closest_point({2, f}, p).distance);
+    }
+    if (radius > 0 && std::isfinite(radius)) out.push_back({v, p, radius, std::move(pairs)});
+  }
+  return out;
+}
+
+TipBalls::TipBalls(std::vector<CuspTip> tips) : tips_(std::move(tips)) {
+  std::sort(tips_.begin(), tips_.end(), [](const CuspTip& a, const CuspTip& b) { return a.point.x() < b.point.x(); });
+  for (const CuspTip& t : tips_) max_radius_ = std::max(max_radius_, t.radius);
+}
+
+bool TipBalls::contains(const Vec3& x) const {
+  auto it = std::lower_bound(tips_.begin(), tips_.end(), x.x() - max_radius_,
+                             [](const CuspTip& t, double value) { return t.point.x() < value; });
+  for (; it != tips_.end() && it->point.x() <= x.x() + max_radius_; ++it)
+    if ((x - it->point).norm() < it->radius) return true;
+  return false;
+}
+
+std::optional<double> param_at_distance(const Model& m, int edge, int side, double radius) {
+  const ParamRange r = m.param_range({1, edge});
+  const Vec3 end = m.edge_point(edge, side == 0 ? r.u0 : r.u1);
+  const auto far = [&](double t) { return (m.edge_point(edge, param_from_end(r, side, t)) - end).norm() >= radius; };
+  constexpr int kSteps = 64;
+  for (int k = 1; k <= kSteps; ++k) {
+    const double t = double(k) / kSteps;
+    if (!far(t)) continue;
+    double lo = double(k - 1) / kSteps, hi = t;
+    for (int i = 0; i < 40 && hi - lo > 1e-14; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (far(mid) ? hi : lo) = mid;
+    }
+    return param_from_end(r, side, hi);
+  }
+  return std::nullopt;
+}
+
+}  // namespace cm::geom
