@@ -11,76 +11,12 @@
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/quality/measures.hpp"
+#include "curvemesh/generate/plane_metric.hpp"
 #include "curvemesh/generate/triangulation2d.hpp"
 
 namespace cm::generate {
 
 namespace {
-
-// The face seen through (u, v) scaled by the mean first fundamental form:
-// lengths in the scaled plane approximate lengths on the surface, so that a
-// Euclidean Delaunay triangulation there is close to the surface's own.
-struct Scaling {
-  double su = 1, sv = 1;
-  Vec2 to_plane(const Vec2& uv) const { return {su * uv.x(), sv * uv.y()}; }
-  Vec2 to_uv(const Vec2& p) const { return {p.x() / su, p.y() / sv}; }
-};
-
-Scaling face_scaling(const geom::Model& m, int face) {
-  const geom::ParamRange r = m.param_range({2, face});
-  double e = 0, g = 0;
-  int n = 0;
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j) {
-      const Vec2 uv(r.u0 + (r.u1 - r.u0) * (i + 0.5) / 5, r.v0 + (r.v1 - r.v0) * (j + 0.5) / 5);
-      const geom::SurfaceDerivatives d = m.face_derivatives(face, uv);
-      if (!d.du.allFinite() || !d.dv.allFinite()) continue;
-      e += d.du.norm();
-      g += d.dv.norm();
-      ++n;
-    }
-  Scaling s;
-  if (n > 0 && e > 0 && g > 0) {
-    s.su = e / n;
-    s.sv = g / n;
-  }
-  return s;
-}
-
-// A 2×2 symmetric metric [a b; b c] of the scaled plane: |e|² = eᵀ M e.
-struct Metric2 {
-  double a = 1, b = 0, c = 1;
-  double norm2(const Vec2& e) const { return a * e.x() * e.x() + 2 * b * e.x() * e.y() + c * e.y() * e.y(); }
-  double dot(const Vec2& e, const Vec2& f) const {
-    return a * e.x() * f.x() + b * (e.x() * f.y() + e.y() * f.x()) + c * e.y() * f.y();
-  }
-  Vec2 apply(const Vec2& e) const { return {a * e.x() + b * e.y(), b * e.x() + c * e.y()}; }
-  Metric2 scaled(double s) const { return {a * s, b * s, c * s}; }
-  bool positive() const { return a > 0 && c > 0 && a * c - b * b > 1e-14 * a * c && std::isfinite(a + b + c); }
-};
-
-// Circumcentre and squared circumradius of (p, q, r) in the metric m.
-bool metric_circumcircle(const Vec2& p, const Vec2& q, const Vec2& r, const Metric2& m, Vec2* centre, double* r2) {
-  // With y = centre - p: 2 (q - p)ᵀ M y = |q - p|², the same for r.
-  const Vec2 e1 = q - p, e2 = r - p;
-  const Vec2 w1 = m.apply(e1), w2 = m.apply(e2);
-  const double det = w1.x() * w2.y() - w1.y() * w2.x();
-  if (!(std::abs(det) > 1e-300)) return false;
-  const double s1 = 0.5 * m.norm2(e1), s2 = 0.5 * m.norm2(e2);
-  const Vec2 y((s1 * w2.y() - s2 * w1.y()) / det, (w1.x() * s2 - w2.x() * s1) / det);
-  if (!y.allFinite()) return false;
-  *centre = p + y;
-  *r2 = m.norm2(y);
-  return true;
-}
-
-// The unit normal, in metric m, of the plane vector e, on its left.
-Vec2 metric_normal(const Vec2& e, const Metric2& m) {
-  const Vec2 w = m.apply(e);
-  Vec2 n(-w.y(), w.x());  // ⟂ to M e, i.e. M-orthogonal to e
-  if (e.x() * n.y() - e.y() * n.x() < 0) n = -n;
-  return n / std::sqrt(m.norm2(n));
-}
 
 constexpr double kHalfSqrt3 = 0.8660254037844386;
 constexpr double kNearFold = 0.17;  // cos 80°: see FaceMesher::folds
