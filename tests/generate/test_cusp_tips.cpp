@@ -159,3 +159,40 @@ TEST(CuspTips, MeshKeepsTheBallsEmptyAndTheNeedlesFair) {
   for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
   EXPECT_GE(worst, 9.0);
 }
+
+// 917_fusee.stp at a coarse hmax (the bounding-box diagonal / 8): one of its
+// tips is cut short by the model (its strip is still about 30 times
+// narrower than the size where it leaves the ball), so the faces' rings
+// grade down to the strip's width next to it and the cap must follow them.
+// Its points then go onto the sphere from tets of either side: the fan's
+// (their far face's centre, centroid or longest edge's middle) and the flat
+// ones just outside (their circumcentre, inside the ball, taken out). With
+// the ring so graded and only the fan's tets refining the cap, the worst
+// dihedral angle there was 3.9°.
+TEST(CuspTips, CapsFollowARingGradedDownToTheStrip) {
+  const auto model = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/917_fusee.stp");
+  const geom::BoundingBox box = model->bounding_box();
+  size::SizeOptions so;
+  so.hmax = (box.max - box.min).norm() / 8;
+  const auto size = size::build_size_field(*model, so);
+  generate::VolumeMeshStats st;
+  mesh::TetMesh m = generate::mesh_volume(*model, *size.field, {}, &st);
+  ASSERT_GE(st.tips.size(), 5u);
+  optimize::ImproveOptions io;
+  io.model = model.get();
+  io.tips = st.tips;
+  optimize::improve_quality(m, io);
+  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
+  for (const auto& tip : st.tips)
+    for (VertId v = 0; v < m.num_verts(); ++v) {
+      const double d = (m.coords[v] - tip.point).norm();
+      if (d > 0) {
+        // Edge nodes land on the sphere to the edge search's tolerance.
+        EXPECT_GE(d, tip.radius * (1 - 1e-6))
+            << "vertex " << v << " (dim " << m.vert_class[v].dim << ") in the ball of model vertex " << tip.vertex;
+      }
+    }
+  double worst = 180;
+  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
+  EXPECT_GE(worst, 10.0);
+}

@@ -73,6 +73,11 @@ class FaceMesher {
  private:
   // New points closer than this many sizes to a vertex are refused.
   static constexpr double kCrowded = 0.5;
+  // The same for a tip fan's ring points (split_shell): the front may have
+  // come up to the sphere before the fan is split, and a ring edge left
+  // several sizes long beside a narrow strip makes a needle with a flat
+  // cap triangle (917_fusee at --hmax diagonal/35: 6.1°).
+  static constexpr double kCrowdedOnSphere = 0.25;
   // Balls whose worst triangle is at least this good are smoothed for the
   // sum of qualities, the others for their worst triangle.
   static constexpr double kSmoothForMean = 0.7;
@@ -276,7 +281,7 @@ class FaceMesher {
     const Vec2 x = origin + hi * ray;
     Metric2 m = surface_metric(x);
     if (!m.positive()) m = Metric2{};
-    return insert_metric(x, t, m, fan) >= 0;
+    return insert_metric(x, t, m, fan, true, kCrowdedOnSphere) >= 0;
   }
 
   // Inserts plane point x by a Bowyer–Watson cavity grown from the triangle
@@ -284,8 +289,9 @@ class FaceMesher {
   // in-circle test of metric m; falls back to the exact Delaunay insertion
   // of the plane if that cavity is not star-shaped. Returns the vertex, or
   // -1 if x is outside the face or (with `crowding`) closer in 3D than
-  // kCrowded sizes to a vertex of the cavity. `fan` gets the new triangles.
-  int insert_metric(const Vec2& x, int seed, const Metric2& m, std::vector<int>& fan, bool crowding = true) {
+  // `crowded` sizes to a vertex of the cavity. `fan` gets the new triangles.
+  int insert_metric(const Vec2& x, int seed, const Metric2& m, std::vector<int>& fan, bool crowding = true,
+                    double crowded = kCrowded) {
     const Location loc = locate_point(t_, x, seed);
     if (loc.kind == Location::kOutside || loc.kind == Location::kOnVertex) return -1;
     const auto& p = t_.points;
@@ -316,7 +322,7 @@ class FaceMesher {
       if (in_tip(d.point)) return -1;
       for (const int t : cavity_)
         for (const int v : t_.tris[t])
-          if ((d.point - xyz_[v]).norm() < kCrowded * h_[v]) return -1;
+          if ((d.point - xyz_[v]).norm() < crowded * h_[v]) return -1;
     }
     int id = t_.insert_in_cavity(x, cavity_, &fan);
     if (id < 0) {

@@ -153,22 +153,30 @@ Vec3 circumcentre(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return a + (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u) + w.squaredNorm() * u.cross(v)) / det;
 }
 
-// A tet of a cusp tip's fan (a corner at the tip's vertex; the ball holds
-// no other point) is refined on the sphere instead of at its circumcentre,
-// which lies inside the ball: its far face is a triangle of the fan's cap,
-// and the cap is refined as a surface, Delaunay refinement on the sphere,
-// while that face's circumradius is over the size or over √2 its shortest
-// edge (angles under 20°) and half the size. The point is the face's circumcentre taken to
-// the sphere along the ray from the vertex, then, if that one is refused,
-// its centroid likewise. On the sphere, not beyond it: the tet's
-// circumsphere passes through the sphere's centre, so it holds the cap of
-// the sphere over the far face, and the point's cavity takes the tet.
-// Empty for any other tet. `h` gets the far face's size (the mean of its
-// vertices'), the one its points are judged by: the tip's vertex has its
-// own, larger, from the ball around it.
+// Where a tet whose circumcentre `x` lies in a cusp tip's ball gets its
+// point instead, on the sphere: the ball holds no point but its vertex.
+// - A tet of the tip's fan (a corner at the vertex): its far face is a
+//   triangle of the fan's cap, and the cap is refined as a surface, Delaunay
+//   refinement on the sphere, while that face's circumradius is over the
+//   size or over √2 its shortest edge (angles under 20°) and half the size.
+//   The points are the face's circumcentre, then its centroid, then the
+//   middle of its longest edge (the circumcentre of a thin face by the ring
+//   lies outside the solid), each taken to the sphere along the ray from
+//   the vertex. On the sphere, not beyond it: the tet's circumsphere passes
+//   through the sphere's centre, so it holds the cap of the sphere over the
+//   far face, and the point's cavity takes the tet. `h` gets the far face's
+//   size (the mean of its vertices'), the one its points are judged by: the
+//   tip's vertex has its own, larger, from the ball around it.
+// - Any other tet (a flat one just outside the sphere, on cap points): x
+//   taken out to the sphere, which splits the cap under it.
 std::vector<Vec3> shell_points(const mesh::TetMesh& m, const std::array<VertId, 4>& tv,
                                const std::map<VertId, const geom::CuspTip*>& tip_of, const std::vector<double>& vh,
-                               double* h_face) {
+                               const geom::CuspTip& ball, const Vec3& x, double* h_face) {
+  const auto to_sphere = [](const geom::CuspTip& tip, const Vec3& c, std::vector<Vec3>& out) {
+    const Vec3 ray = c - tip.point;
+    if (ray.norm() > 0) out.push_back(tip.point + ray * (tip.radius / ray.norm()));
+  };
+  std::vector<Vec3> out;
   for (int k = 0; k < 4; ++k) {
     const auto it = tip_of.find(tv[k]);
     if (it == tip_of.end()) continue;
@@ -189,14 +197,15 @@ std::vector<Vec3> shell_points(const mesh::TetMesh& m, const std::array<VertId, 
     // size: the new point is that far from every other, so this ends.
     if (radius <= h && (radius <= std::numbers::sqrt2 * shortest || radius <= 0.5 * h)) return {};
     *h_face = h;
-    std::vector<Vec3> out;
-    for (const Vec3& c : {centre, Vec3((f[0] + f[1] + f[2]) / 3)}) {
-      const Vec3 ray = c - tip.point;
-      if (ray.norm() > 0) out.push_back(tip.point + ray * (tip.radius / ray.norm()));
-    }
+    int longest = 0;  // the edge f[longest] -> f[longest + 1]
+    for (int e = 1; e < 3; ++e)
+      if ((f[(e + 1) % 3] - f[e]).squaredNorm() > (f[(longest + 1) % 3] - f[longest]).squaredNorm()) longest = e;
+    for (const Vec3& c : {centre, Vec3((f[0] + f[1] + f[2]) / 3), Vec3(0.5 * (f[longest] + f[(longest + 1) % 3]))})
+      to_sphere(tip, c, out);
     return out;
   }
-  return {};
+  to_sphere(ball, x, out);
+  return out;
 }
 
 // Delaunay refinement to the size field: circumcentres of tets too large for
@@ -261,8 +270,8 @@ void refine_interior(const size::SizeField& size, const std::vector<geom::CuspTi
       Vec3 x = c.centre;
       double h = c.h;
       TetId home = kNone;
-      if (tips.contains(x)) {
-        for (const Vec3& y : shell_points(m, c.verts, tip_of, vh, &h)) {
+      if (const geom::CuspTip* ball = tips.find(x)) {
+        for (const Vec3& y : shell_points(m, c.verts, tip_of, vh, *ball, x, &h)) {
           try {
             const TetId at = dt.locate(y, c.tet);
             if (m.tet_region[at] != m.tet_region[c.tet] || m.tet_region[at] == 0) continue;

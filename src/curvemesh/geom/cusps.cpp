@@ -133,12 +133,12 @@ TipBalls::TipBalls(std::vector<CuspTip> tips) : tips_(std::move(tips)) {
   for (const CuspTip& t : tips_) max_radius_ = std::max(max_radius_, t.radius);
 }
 
-bool TipBalls::contains(const Vec3& x) const {
+const CuspTip* TipBalls::find(const Vec3& x) const {
   auto it = std::lower_bound(tips_.begin(), tips_.end(), x.x() - max_radius_,
                              [](const CuspTip& t, double value) { return t.point.x() < value; });
   for (; it != tips_.end() && it->point.x() <= x.x() + max_radius_; ++it)
-    if ((x - it->point).norm() < it->radius) return true;
-  return false;
+    if ((x - it->point).norm() < it->radius) return &*it;
+  return nullptr;
 }
 
 std::optional<double> param_at_distance(const Model& m, int edge, int side, double radius) {

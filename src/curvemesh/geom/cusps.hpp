@@ -47,7 +47,9 @@ class TipBalls {
  public:
   TipBalls() = default;
   explicit TipBalls(std::vector<CuspTip> tips);
-  bool contains(const Vec3& x) const;
+  bool contains(const Vec3& x) const { return find(x) != nullptr; }
+  /// The tip whose ball holds x, or null.
+  const CuspTip* find(const Vec3& x) const;
   bool empty() const { return tips_.empty(); }
 
  private:
