@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <map>
 #include <numbers>
-#include <optional>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
