@@ -510,6 +510,80 @@ Expansion<96> exact_orient3d_det(const std::array<Expansion<24>, 4>& minor) {
   return sum.value().sign();
 }
 
+// The adaptive stage of insphere, between the filter and insphere_exact:
+// points rounded onto a sphere (a sphere's or a cylinder's mesh) are not
+// exactly cospherical, but closer than the filter can tell, and there the
+// exact stage was most of the Delaunay kernel's time.
+//
+// With the rows translated to e, x = fl(p - e) and t its rounding tail
+// (p - e = x + t exactly, |t| <= u |x|), and D the filter's determinant
+// a_lift M_a - b_lift M_b + c_lift M_c - d_lift M_d (M_a = det[b; c; d], ...):
+// - D_B = D(x), computed exactly; it is D itself when every tail is zero.
+// - dD = the first-order part of D(x + t) - D(x), in floating point: for each
+//   row, 2 (x . t) times its minor plus its lift times the minor's change
+//   t_p . (q x r) + t_q . (r x p) + t_r . (p x q).
+// Each monomial of D is a product of five differences, so the terms of second
+// order and above are at most ((1 + u)^5 - 1 - 5u) P <= 10.001 u^2 P, with P the
+// permanent (the filter's, which it bounds from below by a factor 1 - gamma_16).
+// dD's exact value has permanent at most 5 u P and its tree at most 16 rounded
+// operations per monomial, so its computed value errs by at most gamma_16 5 u P
+// <= 80.01 u^2 P. Hence |D - (D_B + dD~)| < 96 u^2 P~ = E, and the sign of D is
+// certified when the exact sum D_B + dD~ lies outside [-E, E]. Returns 2 when it
+// does not (D zero, or nearly).
+[[gnu::noinline]] int insphere_adaptive(const double* a, const double* b, const double* c,
+                                        const double* d, const double* e, double permanent) {
+  const double* p[4] = {a, b, c, d};
+  double x[4][3], t[4][3];
+  bool exact_differences = true;
+  for (int i = 0; i < 4; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      two_sum(p[i][k], -e[k], x[i][k], t[i][k]);
+      exact_differences = exact_differences && t[i][k] == 0.0;
+    }
+  }
+  // D_B: the lifted column expanded over the four rows' 3x3 minors.
+  const RawMinors<4> raw({x[0], x[1], x[2], x[3]});
+  ExpansionSum<4 * 2 * 24 * 6> sum;
+  sum.add(multiply(raw.det3(1, 2, 3), exact_lift<3>(x[0], 1.0)));
+  sum.add(multiply(raw.det3(0, 2, 3), exact_lift<3>(x[1], -1.0)));
+  sum.add(multiply(raw.det3(0, 1, 3), exact_lift<3>(x[2], 1.0)));
+  sum.add(multiply(raw.det3(0, 1, 2), exact_lift<3>(x[3], -1.0)));
+  const Expansion<1152>& d_b = sum.value();
+  if (exact_differences) return d_b.sign();
+
+  const auto cross = [&](int i, int j, double* out) {
+    out[0] = x[i][1] * x[j][2] - x[i][2] * x[j][1];
+    out[1] = x[i][2] * x[j][0] - x[i][0] * x[j][2];
+    out[2] = x[i][0] * x[j][1] - x[i][1] * x[j][0];
+  };
+  const auto dot = [](const double* u, const double* v) { return (u[0] * v[0] + u[1] * v[1]) + u[2] * v[2]; };
+  double first_order[4];
+  for (int i = 0; i < 4; ++i) {
+    int r[3];
+    for (int k = 0, n = 0; k < 4; ++k) {
+      if (k != i) r[n++] = k;
+    }
+    double qr[3], rp[3], pq[3];
+    cross(r[1], r[2], qr);
+    cross(r[2], r[0], rp);
+    cross(r[0], r[1], pq);
+    const double minor = dot(x[r[0]], qr);
+    const double minor_change = (dot(t[r[0]], qr) + dot(t[r[1]], rp)) + dot(t[r[2]], pq);
+    const double lift = dot(x[i], x[i]);
+    const double lift_change = 2.0 * dot(x[i], t[i]);
+    first_order[i] = lift_change * minor + lift * minor_change;
+  }
+  const double change = (first_order[0] - first_order[1]) + (first_order[2] - first_order[3]);
+  const double bound = 96.0 * 0x1p-106 * permanent;
+  Expansion<1> change_e, bound_e;
+  change_e.push(change);
+  bound_e.push(bound);
+  const Expansion<1153> estimate = add(d_b, change_e);
+  if (add(estimate, negated(bound_e)).sign() > 0) return 1;
+  if (add(estimate, bound_e).sign() < 0) return -1;
+  return 2;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -562,6 +636,8 @@ int insphere(const double* a, const double* b, const double* c, const double* d,
   if (det.permanent < kIntegerPermanentLimit && small_integers(a) && small_integers(b) &&
       small_integers(c) && small_integers(d) && small_integers(e))
     return sign_of(det.value);
+  if (const int s = insphere_adaptive(a, b, c, d, e, det.permanent); s != 2) return s;
+  ++exact_stats().insphere_unsettled;
   return insphere_exact(a, b, c, d, e);
 }
 

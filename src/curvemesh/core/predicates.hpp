@@ -68,8 +68,12 @@ inline int insphere_inline(const double* a, const double* b, const double* c, co
 
 /// How many calls of this thread fell through the filter to the exact stage
 /// (for benchmarks and tests). Reset by assigning `exact_stats() = {}`.
+/// insphere_unsettled counts, among the insphere ones, those its adaptive
+/// stage (first-order error terms, for near-cospherical points) left to the
+/// full expansion.
 struct ExactStats {
   long long orient2d = 0, incircle = 0, orient3d = 0, insphere = 0;
+  long long insphere_unsettled = 0;
 };
 ExactStats& exact_stats();
 
