@@ -308,11 +308,24 @@ void SizeOctree::build_incidence() {
   // Conformity is settled finest first and, within a level, in the order
   // octants were made: lowering one face's corners changes what the next
   // face needs, so this order is part of the result.
-  std::sort(hanging_.begin(), hanging_.end(), [&](const Hanging& a, const Hanging& b) {
-    const std::uint32_t oa = leaves_[a.leaf], ob = leaves_[b.leaf];
-    if (octants_[oa].level != octants_[ob].level) return octants_[oa].level > octants_[ob].level;
-    return oa != ob ? oa < ob : a.midpoint < b.midpoint;
-  });
+  // Sorted on one integer per entry: (deepest level first, octant, midpoint)
+  // packed into 5 + 32 + 5 bits, the node alongside; no two entries share
+  // an octant and midpoint.
+  {
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> order(hanging_.size());
+    for (std::size_t i = 0; i < hanging_.size(); ++i) {
+      const Hanging& hg = hanging_[i];
+      const std::uint32_t o = leaves_[hg.leaf];
+      const std::uint64_t depth_first = static_cast<std::uint64_t>(opt_.max_depth - octants_[o].level);
+      order[i] = {(depth_first << 37) | (std::uint64_t{o} << 5) | hg.midpoint, hg.node};
+    }
+    std::sort(order.begin(), order.end());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const auto o = static_cast<std::uint32_t>((order[i].first >> 5) & 0xffffffffu);
+      hanging_[i] = {static_cast<std::uint32_t>(octant_leaf_[o]), order[i].second,
+                     static_cast<std::uint8_t>(order[i].first & 31u)};
+    }
+  }
   hanging_start_.assign(n + 1, 0);
   const auto each_node = [&](const Hanging& hg, auto&& visit) {
     visit(hg.node);
@@ -405,19 +418,22 @@ std::vector<std::uint32_t> SizeOctree::conform(std::span<const std::uint32_t> di
   };
   for (const std::uint32_t node : dirty) enlist_all(node);
 
+  // Both sweeps visit the queued entries in hanging_'s order (the second in
+  // reverse) and queue only entries still ahead of the one they settle, so
+  // a heap of the queued entries and a scan of the flags visit the same
+  // entries in the same order: the scan when a good part of them is queued.
+  const std::size_t total = hanging_.size();
+  const auto worth_a_scan = [&](std::size_t queued) { return 8 * queued > total; };
+
   // Finest first: where a hanging corner asks for less than a larger
   // octant interpolates there, lower that octant's corners on the face (or
   // edge) to a common cap t, the least change that makes the interpolation
   // equal to what the corner asks; corners already below t keep their size.
-  std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, std::greater<>> ahead(std::greater<>{}, start);
   std::vector<std::uint32_t> lowered;
-  while (!ahead.empty()) {
-    const std::uint32_t e = ahead.top();
-    ahead.pop();
-    hanging_queued_[e] = 0;
+  const auto settle_ahead = [&](std::uint32_t e, auto&& enqueue) {
     const Hanging& hg = hanging_[e];
     const double want = node_value_[hg.node];
-    if (!(interpolate(hg) - want > kConformTolerance * want)) continue;
+    if (!(interpolate(hg) - want > kConformTolerance * want)) return;
     std::array<double, 4> c;
     c.fill(std::numeric_limits<double>::infinity());
     int n = 0;
@@ -447,10 +463,25 @@ std::vector<std::uint32_t> SizeOctree::conform(std::span<const std::uint32_t> di
           const std::uint32_t later = hanging_of_[q];
           if (later > e && !hanging_queued_[later]) {
             hanging_queued_[later] = 1;
-            ahead.push(later);
+            enqueue(later);
           }
         }
       }
+    }
+  };
+  if (worth_a_scan(start.size())) {
+    for (std::uint32_t e = 0; e < total; ++e)
+      if (hanging_queued_[e]) {
+        hanging_queued_[e] = 0;
+        settle_ahead(e, [](std::uint32_t) {});
+      }
+  } else {
+    std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, std::greater<>> ahead(std::greater<>{}, start);
+    while (!ahead.empty()) {
+      const std::uint32_t e = ahead.top();
+      ahead.pop();
+      hanging_queued_[e] = 0;
+      settle_ahead(e, [&](std::uint32_t q) { ahead.push(q); });
     }
   }
 
@@ -458,22 +489,33 @@ std::vector<std::uint32_t> SizeOctree::conform(std::span<const std::uint32_t> di
   // entries to redo are the first sweep's and those of the corners it lowered.
   for (const std::uint32_t e : start) hanging_queued_[e] = 1;
   for (const std::uint32_t node : lowered) enlist_all(node);
-  std::priority_queue<std::uint32_t> behind(std::less<std::uint32_t>{}, std::move(start));
-  while (!behind.empty()) {
-    const std::uint32_t e = behind.top();
-    behind.pop();
-    hanging_queued_[e] = 0;
+  const auto settle_behind = [&](std::uint32_t e, auto&& enqueue) {
     const Hanging& hg = hanging_[e];
     const double v = interpolate(hg), old = node_value_[hg.node];
-    if (v == old) continue;
+    if (v == old) return;
     if (std::abs(v - old) > kConformTolerance * old) moved.push_back(hg.node);
     node_value_[hg.node] = v;
     for (std::uint32_t q = hanging_start_[hg.node]; q < hanging_start_[hg.node + 1]; ++q) {
       const std::uint32_t earlier = hanging_of_[q];
       if (earlier < e && !hanging_queued_[earlier]) {
         hanging_queued_[earlier] = 1;
-        behind.push(earlier);
+        enqueue(earlier);
       }
+    }
+  };
+  if (worth_a_scan(start.size())) {
+    for (std::uint32_t e = static_cast<std::uint32_t>(total); e-- > 0;)
+      if (hanging_queued_[e]) {
+        hanging_queued_[e] = 0;
+        settle_behind(e, [](std::uint32_t) {});
+      }
+  } else {
+    std::priority_queue<std::uint32_t> behind(std::less<std::uint32_t>{}, std::move(start));
+    while (!behind.empty()) {
+      const std::uint32_t e = behind.top();
+      behind.pop();
+      hanging_queued_[e] = 0;
+      settle_behind(e, [&](std::uint32_t q) { behind.push(q); });
     }
   }
   std::sort(moved.begin(), moved.end());
