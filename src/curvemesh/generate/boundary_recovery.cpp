@@ -8,6 +8,8 @@
 #include <unordered_set>
 
 #include <fmt/format.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/generate/flip_recovery.hpp"
@@ -367,8 +369,10 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
         if (check(tv[f[0]]) || check(tv[f[1]]) || check(tv[f[2]]))
           all_faces.push_back(sorted3({tv[f[0]], tv[f[1]], tv[f[2]]}));
     }
-    std::sort(all_edges.begin(), all_edges.end());
-    std::sort(all_faces.begin(), all_faces.end());
+    // Keys equal only when the simplices are: the parallel sort gives the
+    // same arrays as a serial one.
+    tbb::parallel_invoke([&] { tbb::parallel_sort(all_edges.begin(), all_edges.end()); },
+                         [&] { tbb::parallel_sort(all_faces.begin(), all_faces.end()); });
     auto edge_in = [&](VertId a, VertId b) {
       return std::binary_search(all_edges.begin(), all_edges.end(), edge_key(a, b));
     };

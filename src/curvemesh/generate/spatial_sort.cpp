@@ -4,6 +4,10 @@
 #include <cmath>
 #include <random>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 namespace cm::generate {
 
 namespace {
@@ -63,12 +67,14 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
     std::uint32_t index;
   };
   std::vector<Keyed> items(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 q = (points[i] - lo) * scale;
-    items[i] = {hilbert_key(static_cast<std::uint32_t>(q.x()), static_cast<std::uint32_t>(q.y()),
-                            static_cast<std::uint32_t>(q.z()), kBits),
-                static_cast<std::uint32_t>(i)};
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const Vec3 q = (points[i] - lo) * scale;
+      items[i] = {hilbert_key(static_cast<std::uint32_t>(q.x()), static_cast<std::uint32_t>(q.y()),
+                              static_cast<std::uint32_t>(q.z()), kBits),
+                  static_cast<std::uint32_t>(i)};
+    }
+  });
   std::mt19937_64 rng(seed);
   std::shuffle(items.begin(), items.end(), rng);
   // Rounds of growing size: ..., n/8, n/4, n/2 (the first one at least 1000).
@@ -80,8 +86,10 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
   }
   std::size_t begin = 0;
   for (auto it = ends.rbegin(); it != ends.rend(); ++it) {
-    std::sort(items.begin() + static_cast<std::ptrdiff_t>(begin), items.begin() + static_cast<std::ptrdiff_t>(*it),
-              [](const Keyed& a, const Keyed& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); });
+    // A total order (indices are distinct): any sort gives the same result.
+    tbb::parallel_sort(items.begin() + static_cast<std::ptrdiff_t>(begin),
+                       items.begin() + static_cast<std::ptrdiff_t>(*it),
+                       [](const Keyed& a, const Keyed& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); });
     begin = *it;
   }
   for (std::size_t i = 0; i < n; ++i) order[i] = items[i].index;
