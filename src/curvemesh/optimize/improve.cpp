@@ -18,6 +18,7 @@
 #include "curvemesh/modify/relocate.hpp"
 #include "curvemesh/modify/surface.hpp"
 #include "curvemesh/modify/swap.hpp"
+#include "curvemesh/optimize/detail/edit_clock.hpp"
 #include "curvemesh/optimize/measured_swap.hpp"
 #include "curvemesh/optimize/shell_insert.hpp"
 #include "curvemesh/optimize/vertex_search.hpp"
@@ -368,8 +369,15 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
   // After the first pass only the tets an operation made (the hook reports
   // them) and those still waiting can need work: no pass rescans the mesh.
   std::vector<TetId> touched, candidates;
-  ed.set_hook([&touched](const mesh::TetMesh&, std::span<const TetId> created) {
+  // A tet every operator refused is refused again, for the same reasons,
+  // until an edit makes a tet at one of its vertices (the operators see
+  // only those balls) or the mode changes (search and collapse once stuck):
+  // it is skipped until then. Its entry: when it was given up on, in which mode.
+  detail::EditClock clock(m.num_verts());
+  std::vector<std::pair<std::uint64_t, bool>> given_up;
+  ed.set_hook([&](const mesh::TetMesh& mesh, std::span<const TetId> created) {
     touched.insert(touched.end(), created.begin(), created.end());
+    clock.tick(mesh, created);
   });
   // The search and collapses wait until the cheap operators are stuck: the
   // search drives the mean ratio of the balls it improves down to the
@@ -428,6 +436,10 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
     std::size_t changes = 0;
     for (const auto& [q0, t] : bad) {
       if (ed.is_dead(t) || !needs_work(m, t, modify::tet_quality(m, m.tet2verts[t]), o, tips.tip_vertex)) continue;
+      if (t < given_up.size() && given_up[t].first != 0 && given_up[t].second == stuck &&
+          clock.tet_unchanged_since(given_up[t].first, m.tet2verts[t]))
+        continue;
+      const std::size_t changes_before = changes;
       if (o.deletion && o.model) {
         Timer op;
         const bool done = try_delete(ed, cav, *boundary, o, t, st, touched);
@@ -468,6 +480,10 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
         Timer op;
         changes += try_insert(ed, cav, tips, t, st);
         st.insertion_seconds += op.seconds();
+      }
+      if (changes == changes_before) {
+        if (given_up.size() < m.tet2verts.size()) given_up.resize(m.tet2verts.size(), {0, false});
+        given_up[t] = {clock.now, stuck};
       }
     }
     if (changes == 0) {
