@@ -4,6 +4,9 @@
 #include <iterator>
 #include <stdexcept>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/core/predicates.hpp"
 #include "curvemesh/generate/spatial_sort.hpp"
@@ -143,23 +146,32 @@ std::size_t Delaunay3d::protect_all(std::span<const mesh::ClassifiedTri> faces) 
   for (const auto& f : faces) keys.push_back(sorted(f.verts));
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  std::vector<char> found(keys.size(), 0);
-  for (TetId t = 0; t < m.tet2verts.size(); ++t) {
-    if (editor_.is_dead(t)) continue;
-    const auto& tv = m.tet2verts[t];
-    for (int f = 0; f < 4; ++f) {
-      const auto& fv = mesh::kFaceVerts[f];
-      const auto key = sorted({tv[fv[0]], tv[fv[1]], tv[fv[2]]});
-      const auto it = std::lower_bound(keys.begin(), keys.end(), key);
-      if (it == keys.end() || *it != key) continue;
-      const Index packed = mesh::pack_face(t, f);
-      if (!editor_.face_marked(packed)) {
-        // mark_face marks both sides: count the face once.
-        ++protected_count_;
-        editor_.mark_face(packed);
+  // Every tet face is looked up, in parallel; the marking, which edits,
+  // follows in tet order.
+  const std::size_t nt = m.tet2verts.size();
+  std::vector<std::uint32_t> hit(4 * nt, kNone);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      if (editor_.is_dead(static_cast<TetId>(t))) continue;
+      const auto& tv = m.tet2verts[t];
+      for (int f = 0; f < 4; ++f) {
+        const auto& fv = mesh::kFaceVerts[f];
+        const auto key = sorted({tv[fv[0]], tv[fv[1]], tv[fv[2]]});
+        const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+        if (it != keys.end() && *it == key) hit[4 * t + static_cast<std::size_t>(f)] = static_cast<std::uint32_t>(it - keys.begin());
       }
-      found[static_cast<std::size_t>(it - keys.begin())] = 1;
     }
+  });
+  std::vector<char> found(keys.size(), 0);
+  for (std::size_t k = 0; k < hit.size(); ++k) {
+    if (hit[k] == kNone) continue;
+    const Index packed = mesh::pack_face(static_cast<TetId>(k / 4), static_cast<int>(k % 4));
+    if (!editor_.face_marked(packed)) {
+      // mark_face marks both sides: count the face once.
+      ++protected_count_;
+      editor_.mark_face(packed);
+    }
+    found[hit[k]] = 1;
   }
   return static_cast<std::size_t>(std::count(found.begin(), found.end(), 0));
 }
