@@ -14,7 +14,10 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 namespace cm::size {
 
@@ -87,7 +90,7 @@ std::vector<std::uint32_t> SizeOctree::assign_corners() {
   leaves_ = leaf_octants();
   by_octant_.resize(leaves_.size());
   std::iota(by_octant_.begin(), by_octant_.end(), 0u);
-  std::sort(by_octant_.begin(), by_octant_.end(), [&](std::uint32_t a, std::uint32_t b) { return leaves_[a] < leaves_[b]; });
+  tbb::parallel_sort(by_octant_.begin(), by_octant_.end(), [&](std::uint32_t a, std::uint32_t b) { return leaves_[a] < leaves_[b]; });
   octant_leaf_.assign(octants_.size(), -1);
   leaf_nodes_.resize(leaves_.size());
   node_of_.reset(2 * leaves_.size() + 8);  // corners <= 8 per leaf, ~1.2 per leaf in practice
@@ -108,13 +111,14 @@ std::vector<std::uint32_t> SizeOctree::assign_corners() {
   const std::size_t n = node_units_.size();
   node_value_.assign(n, opt_.hmax);
   node_source_.assign(n, SizeSource::kHmax);
-  for (std::size_t i = 0; i < old_units.size(); ++i) {
+  // Distinct old corners have distinct new ids: the writes do not meet.
+  tbb::parallel_for(std::size_t{0}, old_units.size(), [&](std::size_t i) {
     const auto& u = old_units[i];
     const std::int64_t id = node_of_.find(key(u[0], u[1], u[2]));
     CM_ASSERT(id >= 0);
     node_value_[static_cast<std::size_t>(id)] = old_value[i];
     node_source_[static_cast<std::size_t>(id)] = old_source[i];
-  }
+  });
   const std::vector<double> carried = node_value_;
   // Leaves and requests are both in Morton order: one merge finds every
   // request's leaf. Per corner the smallest size wins, and among equal
@@ -270,61 +274,62 @@ void SizeOctree::build_incidence() {
   // it). Only corners at a change of level look further than their own
   // incidence list; probing every leaf's 18 midpoints in the corner map
   // instead cost a hash lookup each, nearly all of them misses.
-  hanging_.clear();
   const auto& mids = midpoints();
   std::array<std::int8_t, 27> mid_at;
   mid_at.fill(-1);
   for (std::size_t k = 0; k < mids.size(); ++k)
     mid_at[static_cast<std::size_t>(9 * mids[k].at[0] + 3 * mids[k].at[1] + mids[k].at[2])] = static_cast<std::int8_t>(k);
   const std::int64_t top = std::int64_t{1} << opt_.max_depth;
-  for (std::uint32_t v = 0; v < n; ++v) {
-    unsigned covered = 0;
-    for (std::uint32_t k = incident_start_[v]; k < incident_start_[v + 1]; ++k) covered |= 1u << ((incident_[k] & 7u) ^ 7u);
-    if (covered == 0xffu) continue;
-    const auto& u = node_units_[v];
-    const std::uint32_t start = leaves_[incident_[incident_start_[v]] >> 3];
-    std::array<std::uint32_t, 8> found{};
-    int nfound = 0;
-    for (unsigned b = 0; b < 8; ++b) {
-      if (covered >> b & 1u) continue;
-      std::array<std::int64_t, 3> p{};
-      bool inside = true;
-      for (int a = 0; a < 3; ++a) {
-        p[a] = (b >> a & 1u) ? std::int64_t{u[a]} : std::int64_t{u[a]} - 1;
-        inside = inside && p[a] >= 0 && p[a] < top;
-      }
-      if (!inside) continue;
-      const std::uint32_t q = find_near(start, std::uint32_t(p[0]), std::uint32_t(p[1]), std::uint32_t(p[2]));
-      if (std::find(found.begin(), found.begin() + nfound, q) != found.begin() + nfound) continue;
-      found[static_cast<std::size_t>(nfound++)] = q;
-      const Octant& o = octants_[q];
-      const std::uint32_t half = units(o.level) / 2;
-      const std::uint32_t at[3] = {(u[0] - o.ix) / half, (u[1] - o.iy) / half, (u[2] - o.iz) / half};
-      const int k = mid_at[9 * at[0] + 3 * at[1] + at[2]];
-      CM_ASSERT(k >= 0 && (u[0] - o.ix) % half == 0 && (u[1] - o.iy) % half == 0 && (u[2] - o.iz) % half == 0);
-      hanging_.push_back({static_cast<std::uint32_t>(octant_leaf_[q]), v, static_cast<std::uint8_t>(k)});
-    }
-  }
   // Conformity is settled finest first and, within a level, in the order
   // octants were made: lowering one face's corners changes what the next
-  // face needs, so this order is part of the result.
-  // Sorted on one integer per entry: (deepest level first, octant, midpoint)
-  // packed into 5 + 32 + 5 bits, the node alongside; no two entries share
-  // an octant and midpoint.
-  {
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> order(hanging_.size());
-    for (std::size_t i = 0; i < hanging_.size(); ++i) {
-      const Hanging& hg = hanging_[i];
-      const std::uint32_t o = leaves_[hg.leaf];
-      const std::uint64_t depth_first = static_cast<std::uint64_t>(opt_.max_depth - octants_[o].level);
-      order[i] = {(depth_first << 37) | (std::uint64_t{o} << 5) | hg.midpoint, hg.node};
+  // face needs, so this order is part of the result. Each entry is found
+  // as one integer, (deepest level first, octant, midpoint) packed into
+  // 5 + 32 + 5 bits, with its node alongside: no two entries share an
+  // octant and midpoint, so the corners can be searched in parallel and the
+  // sorted list is the same.
+  using Entry = std::pair<std::uint64_t, std::uint32_t>;
+  tbb::enumerable_thread_specific<std::vector<Entry>> found_by_thread;
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, static_cast<std::uint32_t>(n), 4096),
+                    [&](const tbb::blocked_range<std::uint32_t>& range) {
+    std::vector<Entry>& out = found_by_thread.local();
+    for (std::uint32_t v = range.begin(); v != range.end(); ++v) {
+      unsigned covered = 0;
+      for (std::uint32_t k = incident_start_[v]; k < incident_start_[v + 1]; ++k) covered |= 1u << ((incident_[k] & 7u) ^ 7u);
+      if (covered == 0xffu) continue;
+      const auto& u = node_units_[v];
+      const std::uint32_t start = leaves_[incident_[incident_start_[v]] >> 3];
+      std::array<std::uint32_t, 8> found{};
+      int nfound = 0;
+      for (unsigned b = 0; b < 8; ++b) {
+        if (covered >> b & 1u) continue;
+        std::array<std::int64_t, 3> p{};
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) {
+          p[a] = (b >> a & 1u) ? std::int64_t{u[a]} : std::int64_t{u[a]} - 1;
+          inside = inside && p[a] >= 0 && p[a] < top;
+        }
+        if (!inside) continue;
+        const std::uint32_t q = find_near(start, std::uint32_t(p[0]), std::uint32_t(p[1]), std::uint32_t(p[2]));
+        if (std::find(found.begin(), found.begin() + nfound, q) != found.begin() + nfound) continue;
+        found[static_cast<std::size_t>(nfound++)] = q;
+        const Octant& o = octants_[q];
+        const std::uint32_t half = units(o.level) / 2;
+        const std::uint32_t at[3] = {(u[0] - o.ix) / half, (u[1] - o.iy) / half, (u[2] - o.iz) / half};
+        const int k = mid_at[9 * at[0] + 3 * at[1] + at[2]];
+        CM_ASSERT(k >= 0 && (u[0] - o.ix) % half == 0 && (u[1] - o.iy) % half == 0 && (u[2] - o.iz) % half == 0);
+        const auto depth_first = static_cast<std::uint64_t>(opt_.max_depth - o.level);
+        out.emplace_back((depth_first << 37) | (std::uint64_t{q} << 5) | static_cast<std::uint64_t>(k), v);
+      }
     }
-    std::sort(order.begin(), order.end());
-    for (std::size_t i = 0; i < order.size(); ++i) {
-      const auto o = static_cast<std::uint32_t>((order[i].first >> 5) & 0xffffffffu);
-      hanging_[i] = {static_cast<std::uint32_t>(octant_leaf_[o]), order[i].second,
-                     static_cast<std::uint8_t>(order[i].first & 31u)};
-    }
+  });
+  std::vector<Entry> order;
+  for (const std::vector<Entry>& part : found_by_thread) order.insert(order.end(), part.begin(), part.end());
+  tbb::parallel_sort(order.begin(), order.end());
+  hanging_.resize(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const auto o = static_cast<std::uint32_t>((order[i].first >> 5) & 0xffffffffu);
+    hanging_[i] = {static_cast<std::uint32_t>(octant_leaf_[o]), order[i].second,
+                   static_cast<std::uint8_t>(order[i].first & 31u)};
   }
   hanging_start_.assign(n + 1, 0);
   const auto each_node = [&](const Hanging& hg, auto&& visit) {
@@ -354,7 +359,7 @@ void SizeOctree::grade(std::span<const std::uint32_t> seeds, std::vector<std::ui
   initial.reserve(seeds.size());
   for (const std::uint32_t i : seeds)
     if (node_value_[i] < opt_.hmax) initial.emplace_back(node_value_[i], i);
-  std::sort(initial.begin(), initial.end());
+  tbb::parallel_sort(initial.begin(), initial.end());  // distinct ids: a total order
   std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
   std::size_t next = 0;
   while (next < initial.size() || !queue.empty()) {
