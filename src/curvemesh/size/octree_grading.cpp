@@ -427,8 +427,26 @@ std::vector<std::uint32_t> SizeOctree::conform(std::span<const std::uint32_t> di
   // reverse) and queue only entries still ahead of the one they settle, so
   // a heap of the queued entries and a scan of the flags visit the same
   // entries in the same order: the scan when a good part of them is queued.
-  const std::size_t total = hanging_.size();
-  const auto worth_a_scan = [&](std::size_t queued) { return 8 * queued > total; };
+  const auto total = static_cast<std::uint32_t>(hanging_.size());
+  const auto sweep = [&](bool ascending, std::vector<std::uint32_t> queued, auto&& settle) {
+    if (8 * queued.size() > total) {
+      for (std::uint32_t k = 0; k < total; ++k) {
+        const std::uint32_t e = ascending ? k : total - 1 - k;
+        if (!hanging_queued_[e]) continue;
+        hanging_queued_[e] = 0;
+        settle(e, [](std::uint32_t) {});
+      }
+      return;
+    }
+    const auto later = [ascending](std::uint32_t x, std::uint32_t y) { return ascending ? x > y : x < y; };
+    std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, decltype(later)> heap(later, std::move(queued));
+    while (!heap.empty()) {
+      const std::uint32_t e = heap.top();
+      heap.pop();
+      hanging_queued_[e] = 0;
+      settle(e, [&](std::uint32_t q) { heap.push(q); });
+    }
+  };
 
   // Finest first: where a hanging corner asks for less than a larger
   // octant interpolates there, lower that octant's corners on the face (or
@@ -474,21 +492,7 @@ std::vector<std::uint32_t> SizeOctree::conform(std::span<const std::uint32_t> di
       }
     }
   };
-  if (worth_a_scan(start.size())) {
-    for (std::uint32_t e = 0; e < total; ++e)
-      if (hanging_queued_[e]) {
-        hanging_queued_[e] = 0;
-        settle_ahead(e, [](std::uint32_t) {});
-      }
-  } else {
-    std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, std::greater<>> ahead(std::greater<>{}, start);
-    while (!ahead.empty()) {
-      const std::uint32_t e = ahead.top();
-      ahead.pop();
-      hanging_queued_[e] = 0;
-      settle_ahead(e, [&](std::uint32_t q) { ahead.push(q); });
-    }
-  }
+  sweep(true, start, settle_ahead);
 
   // Coarsest first: a hanging corner takes the larger octant's value. The
   // entries to redo are the first sweep's and those of the corners it lowered.
@@ -508,21 +512,7 @@ std::vector<std::uint32_t> SizeOctree::conform(std::span<const std::uint32_t> di
       }
     }
   };
-  if (worth_a_scan(start.size())) {
-    for (std::uint32_t e = static_cast<std::uint32_t>(total); e-- > 0;)
-      if (hanging_queued_[e]) {
-        hanging_queued_[e] = 0;
-        settle_behind(e, [](std::uint32_t) {});
-      }
-  } else {
-    std::priority_queue<std::uint32_t> behind(std::less<std::uint32_t>{}, std::move(start));
-    while (!behind.empty()) {
-      const std::uint32_t e = behind.top();
-      behind.pop();
-      hanging_queued_[e] = 0;
-      settle_behind(e, [&](std::uint32_t q) { behind.push(q); });
-    }
-  }
+  sweep(false, std::move(start), settle_behind);
   std::sort(moved.begin(), moved.end());
   moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
   return moved;
