@@ -86,7 +86,7 @@ class FaceMesher {
   static constexpr int kValencePasses = 2;
   static constexpr double kValenceFloor = 0.6;
 
-  bool alive(std::size_t t) const { return t_.tris[t][0] >= 0; }
+  bool alive(std::size_t t) const { return t_.is_live(static_cast<int>(t)); }
 
   // Inside a cusp tip's ball, which keeps no point but its vertex.
   bool in_tip(const Vec3& x) const { return tips_.contains(x); }
@@ -260,25 +260,15 @@ class FaceMesher {
   // cavity takes the triangle.
   bool split_shell(int t, std::vector<int>& fan) {
     const int k = tip_corner(t);
+    if (k < 0) return false;
     const auto tv = t_.tris[t];
     const int v = tv[k], a = tv[Triangulation2d::next(k)], b = tv[Triangulation2d::prev(k)];
     if ((xyz_[a] - xyz_[b]).norm() <= o_.max_edge * 0.5 * (h_[a] + h_[b])) return false;
     const geom::CuspTip& tip = tip_list_[tip_of_[v]];
     const Vec2 origin = t_.points[v], ray = 0.5 * (t_.points[a] + t_.points[b]) - origin;
-    const double target = tip.radius;
-    const auto reach = [&](double s) {
-      return (m_.face_point(face_, scale_.to_uv(origin + s * ray)) - tip.point).norm();
-    };
-    double lo = 1, hi = 1;
-    if (reach(1) < target) {
-      for (hi = 1.25; hi < 4 && reach(hi) < target; hi *= 1.25) lo = hi;
-      if (!(reach(hi) >= target)) return false;
-      for (int it = 0; it < 30; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (reach(mid) < target ? lo : hi) = mid;
-      }
-    }
-    const Vec2 x = origin + hi * ray;
+    const double s = ray_leaves_ball(m_, face_, scale_, origin, ray, tip.point, tip.radius);
+    if (std::isnan(s)) return false;
+    const Vec2 x = origin + s * ray;
     Metric2 m = surface_metric(x);
     if (!m.positive()) m = Metric2{};
     return insert_metric(x, t, m, fan, true, kCrowdedOnSphere) >= 0;
@@ -641,24 +631,12 @@ class FaceMesher {
   // halfway points raises their worst triangle most.
   int smooth_pass() {
     const std::size_t nv = uv_.size();
-    // Balls as flat arrays: ball_start[v] .. ball_start[v + 1] in ball.
-    std::vector<int> ball_start(nv + 1, 0), ball;
-    for (std::size_t t = 0; t < t_.tris.size(); ++t)
-      if (alive(t))
-        for (const int v : t_.tris[t]) ++ball_start[v + 1];
-    for (std::size_t v = 0; v < nv; ++v) ball_start[v + 1] += ball_start[v];
-    ball.resize(ball_start[nv]);
-    {
-      std::vector<int> fill(ball_start.begin(), ball_start.end() - 1);
-      for (std::size_t t = 0; t < t_.tris.size(); ++t)
-        if (alive(t))
-          for (const int v : t_.tris[t]) ball[fill[v]++] = static_cast<int>(t);
-    }
+    const Triangulation2d::Balls balls = t_.balls();
     int moves = 0;
     for (std::size_t uv = out_.num_boundary; uv < nv; ++uv) {
       const int v = static_cast<int>(uv);
-      const int* first = ball.data() + ball_start[v];
-      const int* last = ball.data() + ball_start[v + 1];
+      const int* first = balls.tris_of.data() + balls.start[uv];
+      const int* last = balls.tris_of.data() + balls.start[uv + 1];
       if (first == last) continue;
       // A tip's fan keeps its far points where they went in, on the sphere.
       if (std::any_of(first, last, [&](int t) { return tip_corner(t) >= 0; })) continue;

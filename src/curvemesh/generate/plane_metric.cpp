@@ -1,6 +1,7 @@
 #include "curvemesh/generate/plane_metric.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace cm::generate {
 
@@ -44,6 +45,20 @@ Vec2 metric_normal(const Vec2& e, const Metric2& m) {
   Vec2 n(-w.y(), w.x());  // ⟂ to M e, i.e. M-orthogonal to e
   if (e.x() * n.y() - e.y() * n.x() < 0) n = -n;
   return n / std::sqrt(m.norm2(n));
+}
+
+double ray_leaves_ball(const geom::Model& m, int face, const Scaling& scale, const Vec2& origin, const Vec2& ray,
+                       const Vec3& centre, double radius) {
+  const auto reach = [&](double s) { return (m.face_point(face, scale.to_uv(origin + s * ray)) - centre).norm(); };
+  if (reach(1) >= radius) return 1;
+  double lo = 1, hi = 1.25;
+  for (; hi < 4 && reach(hi) < radius; hi *= 1.25) lo = hi;
+  if (!(reach(hi) >= radius)) return std::numeric_limits<double>::quiet_NaN();
+  for (int it = 0; it < 30; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (reach(mid) < radius ? lo : hi) = mid;
+  }
+  return hi;
 }
 
 }  // namespace cm::generate

@@ -42,4 +42,11 @@ bool metric_circumcircle(const Vec2& p, const Vec2& q, const Vec2& r, const Metr
 /// The unit normal, in metric m, of the plane vector e, on its left.
 Vec2 metric_normal(const Vec2& e, const Metric2& m);
 
+/// Along the scaled plane's ray origin + s·ray, s >= 1: where the face's
+/// point first lies `radius` or more from `centre` (1 if it does at s = 1,
+/// else bracketed up to s = 4 and bisected to the last bit). NaN when it
+/// does not within s = 4.
+double ray_leaves_ball(const geom::Model& m, int face, const Scaling& scale, const Vec2& origin, const Vec2& ray,
+                       const Vec3& centre, double radius);
+
 }  // namespace cm::generate

@@ -39,6 +39,22 @@ void Triangulation2d::set_constrained(int t, int i, bool on) {
   if (adj[t][i] >= 0) set(adj[t][i], mirror(t, i));
 }
 
+Triangulation2d::Balls Triangulation2d::balls() const {
+  const std::size_t nv = points.size();
+  Balls b;
+  b.start.assign(nv + 1, 0);
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    if (is_live(static_cast<int>(t)))
+      for (const int v : tris[t]) ++b.start[static_cast<std::size_t>(v) + 1];
+  for (std::size_t v = 0; v < nv; ++v) b.start[v + 1] += b.start[v];
+  b.tris_of.resize(static_cast<std::size_t>(b.start[nv]));
+  std::vector<int> fill(b.start.begin(), b.start.end() - 1);
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    if (is_live(static_cast<int>(t)))
+      for (const int v : tris[t]) b.tris_of[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<int>(t);
+  return b;
+}
+
 void Triangulation2d::triangles_around(int v, std::vector<int>& out) const {
   out.clear();
   const int t0 = vert_tri[v];

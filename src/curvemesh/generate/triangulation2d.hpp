@@ -68,6 +68,12 @@ struct Triangulation2d {
   /// first one after the boundary if v is on the boundary. Only the fan of
   /// vert_tri[v]. `out` is cleared first.
   void triangles_around(int v, std::vector<int>& out) const;
+  /// Every vertex's live triangles, all fans, as flat arrays: those of v are
+  /// tris_of[start[v]] .. tris_of[start[v + 1]], in slot order.
+  struct Balls {
+    std::vector<int> start, tris_of;
+  };
+  Balls balls() const;
   /// An edge {a,b}: (t, i) with edge(t, i) == (a, b) if such a triangle
   /// exists, else the triangle holding it as (b, a); {-1,-1} if a and b are not
   /// joined (in the fan of vert_tri[a]). O(degree of a).
