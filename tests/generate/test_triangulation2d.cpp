@@ -617,6 +617,17 @@ TEST(Triangulation2dMesh, PrimitivesKeepInvariants) {
   m.remove_triangle(gone);
   EXPECT_EQ(m.num_tris(), before - 1);
   EXPECT_EQ(m.check(), "");
+  // Balls list every live triangle at each of its vertices, never a deleted slot.
+  const Triangulation2d::Balls balls = m.balls();
+  ASSERT_EQ(balls.start.size(), m.points.size() + 1);
+  EXPECT_EQ(balls.tris_of.size(), 3 * m.num_tris());
+  for (std::size_t w = 0; w < m.points.size(); ++w)
+    for (int k = balls.start[w]; k < balls.start[w + 1]; ++k) {
+      const int f = balls.tris_of[static_cast<std::size_t>(k)];
+      EXPECT_TRUE(m.is_live(f));
+      EXPECT_GE(m.local_index(f, static_cast<int>(w)), 0);
+    }
+  EXPECT_EQ(balls.start[17] - balls.start[16], static_cast<int>(fan.size()) - 1);  // the fan, less the deleted one
   EXPECT_EQ(locate(m, (m.points[verts[0]] + m.points[verts[1]] + m.points[verts[2]]) / 3, 0), -1);
   EXPECT_EQ(m.add_triangle(verts[0], verts[1], verts[2]), gone);
   for (int k = 0; k < 3; ++k) m.set_neighbour(gone, k, nbrs[k], (flags >> k) & 1);
