@@ -62,10 +62,8 @@ Table integrate(const geom::Model& m, int edge, const size::SizeField& size, dou
   return t;
 }
 
-}  // namespace
-
-EdgeMesh discretize_edge(const geom::Model& m, int edge, const size::SizeField& size, const EdgeMeshOptions& o,
-                         int min_segments, std::array<double, 2> tip_radius) {
+EdgeMesh place_nodes(const geom::Model& m, int edge, const size::SizeField& size, const EdgeMeshOptions& o,
+                     int min_segments, std::array<double, 2> tip_radius) {
   EdgeMesh out;
   out.edge = edge;
   out.vertices = m.edge_vertices(edge);
@@ -118,6 +116,24 @@ EdgeMesh discretize_edge(const geom::Model& m, int edge, const size::SizeField& 
   return out;
 }
 
+}  // namespace
+
+EdgeMesh discretize_edge(const geom::Model& m, int edge, const size::SizeField& size, const EdgeMeshOptions& o,
+                         int min_segments, std::array<double, 2> tip_radius, std::array<double, 2> min_first) {
+  EdgeMesh out = place_nodes(m, edge, size, o, min_segments, tip_radius);
+  const std::size_t n = out.points.size();
+  if (out.degenerate || n < 3) return out;
+  bool again = false;
+  for (int side = 0; side < 2; ++side) {
+    const Vec3& end = side == 0 ? out.points.front() : out.points.back();
+    const Vec3& first = side == 0 ? out.points[1] : out.points[n - 2];
+    if (tip_radius[side] > 0 || !(min_first[side] > (first - end).norm())) continue;
+    tip_radius[side] = min_first[side];
+    again = true;
+  }
+  return again ? place_nodes(m, edge, size, o, min_segments, tip_radius) : out;
+}
+
 std::vector<geom::CuspTip> cusp_tips(const geom::Model& m, const size::SizeField& size) {
   return geom::cusp_tips(m, [&](const Vec3& x) { return kTipWidth * size.size(x); });
 }
@@ -135,6 +151,8 @@ std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeFie
   }
   std::vector<double> tip_of(m.count(0) + 1, 0.0);
   for (const geom::CuspTip& tip : tips) tip_of[tip.vertex] = tip.radius;
+  std::vector<double> span_of(m.count(0) + 1, 0.0);
+  for (const geom::WedgeSpan& s : geom::wedge_spans(m)) span_of[s.vertex] = s.radius;
   std::vector<EdgeMesh> out(ne);
   tbb::parallel_for(1, ne + 1, [&](int e) {
     const auto v = m.edge_vertices(e);
@@ -146,7 +164,8 @@ std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeFie
       min_segments = 2;
     }
     out[e - 1] = discretize_edge(m, e, size, o, min_segments,
-                                 {v[0] > 0 ? tip_of[v[0]] : 0.0, v[1] > 0 ? tip_of[v[1]] : 0.0});
+                                 {v[0] > 0 ? tip_of[v[0]] : 0.0, v[1] > 0 ? tip_of[v[1]] : 0.0},
+                                 {v[0] > 0 ? span_of[v[0]] : 0.0, v[1] > 0 ? span_of[v[1]] : 0.0});
   });
   return out;
 }

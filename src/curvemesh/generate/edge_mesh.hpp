@@ -14,7 +14,8 @@
 //
 // Cusp tips (geom/cusps.hpp): an edge with an end at a tip vertex gets its
 // first node there on the tip's sphere, and the metric places the others
-// from that node on.
+// from that node on. At a wedge span's vertex (two cusp pairs) the first
+// node is put at the span's radius only when the metric would put it nearer.
 #include <array>
 #include <vector>
 
@@ -46,9 +47,12 @@ inline constexpr double kTipWidth = 0.9;
 
 /// One edge. `min_segments` >= 1 (see above for how the caller chooses it);
 /// `tip_radius` (at u0, at u1; 0: none) puts the first node at that chord
-/// distance from the end, if the edge gets that far from it.
+/// distance from the end, if the edge gets that far from it; `min_first`
+/// (same order; 0: none) moves the first node out to that distance if the
+/// metric put it nearer.
 EdgeMesh discretize_edge(const geom::Model& model, int edge, const size::SizeField& size,
-                         const EdgeMeshOptions& options, int min_segments = 1, std::array<double, 2> tip_radius = {});
+                         const EdgeMeshOptions& options, int min_segments = 1, std::array<double, 2> tip_radius = {},
+                         std::array<double, 2> min_first = {});
 
 /// The model's cusp tips for this size field: each ends where the strip
 /// between its edges is kTipWidth times the size wide.

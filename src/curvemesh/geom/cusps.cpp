@@ -84,46 +84,83 @@ std::vector<std::array<bool, 2>> cusp_ends(const Model& m) {
   return out;
 }
 
+namespace {
+
+// The cusp pairs at a vertex and, over them, the least (`widest` false) or
+// the greatest (true) distance at which a pair's strip is `width` wide.
+struct PairsAt {
+  std::vector<std::array<int, 2>> pairs;
+  double radius = HUGE_VAL;
+};
+
+PairsAt pairs_at(const Model& m, const std::vector<End>& ends, const Vec3& p,
+                 const std::function<double(const Vec3&)>& width, bool widest) {
+  PairsAt out;
+  if (widest) out.radius = 0;
+  for (std::size_t i = 0; i < ends.size(); ++i)
+    for (std::size_t j = i + 1; j < ends.size(); ++j)
+      if (ends[i].edge != ends[j].edge && is_cusp_pair(ends[i], ends[j])) {
+        const double r = std::min(tip_length(m, ends[i], ends[j].edge, p, width),
+                                  tip_length(m, ends[j], ends[i].edge, p, width));
+        out.radius = widest ? std::max(out.radius, r) : std::min(out.radius, r);
+        out.pairs.push_back({ends[i].edge, ends[j].edge});
+      }
+  return out;
+}
+
+// What bounds a radius around vertex v: 0.4 times the length of every edge
+// there and 0.8 times the distance to its point half-way by parameter (so
+// each edge keeps nodes of its own beyond it; a closed edge comes back to
+// the vertex, so its length alone would not do), and 0.8 times the distance
+// to any face that does not touch the vertex.
+double capped_radius(const Model& m, int v, const Vec3& p, double radius) {
+  std::vector<int> touching;  // faces at the vertex
+  for (const int e : m.upward({0, v})) {
+    if (!m.is_degenerate(e)) {
+      const ParamRange r = m.param_range({1, e});
+      const double half_way = (m.edge_point(e, 0.5 * (r.u0 + r.u1)) - p).norm();
+      radius = std::min({radius, 0.4 * m.length(e), 0.8 * half_way});
+    }
+    for (const int f : m.upward({1, e})) touching.push_back(f);
+  }
+  std::sort(touching.begin(), touching.end());
+  for (int f = 1; f <= m.count(2); ++f) {
+    if (std::binary_search(touching.begin(), touching.end(), f)) continue;
+    const BoundingBox b = m.bounding_box({2, f});
+    const Vec3 gap = (b.min - p).cwiseMax(p - b.max).cwiseMax(0.0);
+    if (gap.norm() >= 1.25 * radius) continue;
+    radius = std::min(radius, 0.8 * m.closest_point({2, f}, p).distance);
+  }
+  return radius;
+}
+
+}  // namespace
+
 std::vector<CuspTip> cusp_tips(const Model& m, const std::function<double(const Vec3&)>& width) {
   std::vector<CuspTip> out;
   const auto at = ends_at_vertices(m);
   for (int v = 1; v < static_cast<int>(at.size()); ++v) {
-    const std::vector<End>& ends = at[v];
     const Vec3 p = m.vertex_point(v);
-    double radius = HUGE_VAL;
-    std::vector<std::array<int, 2>> pairs;
-    for (std::size_t i = 0; i < ends.size(); ++i)
-      for (std::size_t j = i + 1; j < ends.size(); ++j)
-        if (ends[i].edge != ends[j].edge && is_cusp_pair(ends[i], ends[j])) {
-          radius = std::min({radius, tip_length(m, ends[i], ends[j].edge, p, width),
-                             tip_length(m, ends[j], ends[i].edge, p, width)});
-          pairs.push_back({ends[i].edge, ends[j].edge});
-        }
-    // Two faces tapering at one vertex (two pairs) make a thin wedge of the
-    // solid itself there (the tips of t20_data.step's blades): the ball
-    // would hold no point across the wedge's thickness either, and its
-    // needles would span it. The strips there are meshed as any face.
-    if (radius == HUGE_VAL || pairs.size() != 1) continue;
-    std::vector<int> touching;  // faces at the vertex
-    for (const int e : m.upward({0, v})) {
-      if (!m.is_degenerate(e)) {
-        // Half-way along the edge, by parameter: a closed edge comes back
-        // to the vertex, so its length alone would not bound the ball.
-        const ParamRange r = m.param_range({1, e});
-        const double half_way = (m.edge_point(e, 0.5 * (r.u0 + r.u1)) - p).norm();
-        radius = std::min({radius, 0.4 * m.length(e), 0.8 * half_way});
-      }
-      for (const int f : m.upward({1, e})) touching.push_back(f);
-    }
-    std::sort(touching.begin(), touching.end());
-    for (int f = 1; f <= m.count(2); ++f) {
-      if (std::binary_search(touching.begin(), touching.end(), f)) continue;
-      const BoundingBox b = m.bounding_box({2, f});
-      const Vec3 gap = (b.min - p).cwiseMax(p - b.max).cwiseMax(0.0);
-      if (gap.norm() >= 1.25 * radius) continue;
-      radius = std::min(radius, 0.8 * m.closest_point({2, f}, p).distance);
-    }
-    if (radius > 0 && std::isfinite(radius)) out.push_back({v, p, radius, std::move(pairs)});
+    PairsAt found = pairs_at(m, at[v], p, width, false);
+    // Two faces tapering at one vertex are wedge_spans' business.
+    if (found.pairs.size() != 1) continue;
+    const double radius = capped_radius(m, v, p, found.radius);
+    if (radius > 0 && std::isfinite(radius)) out.push_back({v, p, radius, std::move(found.pairs)});
+  }
+  return out;
+}
+
+std::vector<WedgeSpan> wedge_spans(const Model& m) {
+  std::vector<WedgeSpan> out;
+  const auto at = ends_at_vertices(m);
+  const double slope = std::tan(kCuspDegrees * std::numbers::pi / 180);
+  for (int v = 1; v < static_cast<int>(at.size()); ++v) {
+    const Vec3 p = m.vertex_point(v);
+    const auto opened = [&](const Vec3& x) { return slope * (x - p).norm(); };
+    const PairsAt found = pairs_at(m, at[v], p, opened, true);
+    if (found.pairs.size() < 2) continue;
+    const double radius = capped_radius(m, v, p, found.radius);
+    if (radius > 0 && std::isfinite(radius)) out.push_back({v, radius});
   }
   return out;
 }

@@ -58,16 +58,34 @@ class TipBalls {
 };
 
 /// The tips of the model's cusp vertices, by vertex tag. At each, R is the
-/// least distance from the vertex, along either edge of a cusp pair, at
+/// least distance from the vertex, along either edge of its cusp pair, at
 /// which the strip between the two edges is at least `width(x)` wide (x the
-/// point on the edge), over all pairs at the vertex; then at most 0.4 times
-/// the length of every edge at the vertex and 0.8 times the distance to its
-/// point half-way by parameter (so each edge keeps nodes of its own beyond
-/// the ball), and at most 0.8 times the distance to any face that does not
-/// touch the vertex. A vertex whose R would be 0 gets no tip, nor one where
-/// two pairs meet (two faces tapering there: the solid itself is a thin
-/// wedge, which a ball with no point inside cannot mesh).
+/// point on the edge); then at most 0.4 times the length of every edge at
+/// the vertex and 0.8 times the distance to its point half-way by parameter
+/// (so each edge keeps nodes of its own beyond the ball), and at most 0.8
+/// times the distance to any face that does not touch the vertex. A vertex
+/// whose R would be 0 gets no tip, nor one with two pairs (see wedge_spans).
 std::vector<CuspTip> cusp_tips(const Model& model, const std::function<double(const Vec3&)>& width);
+
+/// Where two faces taper at one vertex (two cusp pairs: on t20_data.step,
+/// two chamfers that die out where a circle touches a flat side, on both
+/// sides of the point of contact) a tip is the wrong remedy: both strips stay
+/// narrower than the size over their whole length, so sizing them by their
+/// width refines all of it (twice the tets at hmax 1.2) and the ball leaves
+/// the volume between them to interior points alone (3.3 deg there). The
+/// faces are meshed as any face instead, and what is left to fix is the
+/// sliver triangle at the vertex between a pair's first nodes: its angle
+/// there is the angle the strip has opened to, which grows with the distance
+/// from the vertex where the edges are tangent, and so do the dihedral angles
+/// of the tet on it (7.8 deg at hmax 1.2 with first nodes 1.6 away, 14 deg
+/// at 3.7). So every edge at such a vertex gets its first node at least
+/// `radius` from it: the least distance at which every pair's strip has
+/// opened to kCuspDegrees, within the same caps as a tip's radius.
+struct WedgeSpan {
+  int vertex = 0;
+  double radius = 0;
+};
+std::vector<WedgeSpan> wedge_spans(const Model& model);
 
 /// The parameter on `edge` at chord distance `radius` from the edge's end
 /// `side` (0: u0, 1: u1), nearest that end; nullopt if the edge never gets
