@@ -160,7 +160,24 @@ std::vector<WedgeSpan> wedge_spans(const Model& m) {
     const PairsAt found = pairs_at(m, at[v], p, opened, true);
     if (found.pairs.size() < 2) continue;
     const double radius = capped_radius(m, v, p, found.radius);
-    if (radius > 0 && std::isfinite(radius)) out.push_back({v, radius});
+    if (!(radius > 0) || !std::isfinite(radius)) continue;
+    // A span that leaves a strip's triangle under half the cusp angle has not
+    // opened it, and a long sliver between two nearly collinear segments is
+    // what boundary recovery handles worst (a Steiner point splits it, at a
+    // quarter of the angle).
+    bool opens = true;
+    for (const auto& pair : found.pairs) {
+      std::array<Vec3, 2> x;
+      for (int k = 0; k < 2; ++k) {
+        const int side = m.edge_vertices(pair[k])[0] == v ? 0 : 1;
+        const std::optional<double> u = param_at_distance(m, pair[k], side, radius);
+        opens = opens && u.has_value();
+        if (u) x[k] = m.edge_point(pair[k], *u);
+      }
+      opens = opens && 2 * std::asin(std::min(1.0, 0.5 * (x[0] - x[1]).norm() / radius)) >=
+                           0.5 * kCuspDegrees * std::numbers::pi / 180;
+    }
+    if (opens) out.push_back({v, radius});
   }
   return out;
 }

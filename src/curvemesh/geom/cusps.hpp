@@ -80,7 +80,8 @@ std::vector<CuspTip> cusp_tips(const Model& model, const std::function<double(co
 /// of the tet on it (7.8 deg at hmax 1.2 with first nodes 1.6 away, 14 deg
 /// at 3.7). So every edge at such a vertex gets its first node at least
 /// `radius` from it: the least distance at which every pair's strip has
-/// opened to kCuspDegrees, within the same caps as a tip's radius.
+/// opened to kCuspDegrees, within the same caps as a tip's radius. No span
+/// where a strip is still under half that angle at the radius.
 struct WedgeSpan {
   int vertex = 0;
   double radius = 0;

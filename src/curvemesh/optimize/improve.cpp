@@ -187,18 +187,32 @@ bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, Improve
   return true;
 }
 
+double min_dihedral_of(const mesh::TetMesh& m, std::span<const TetId> tets) {
+  double w = 180;
+  for (const TetId t : tets) w = std::min(w, min_dihedral(m, t));
+  return w;
+}
+
 // Whether moving v to r.target is progress for its ball (the planners
 // judge the mean ratio; a move that raises it by flattening a sliver
-// elsewhere in the ball is none).
-bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation& r, std::vector<TetId>& ball) {
+// elsewhere in the ball is none). Nor may the move take the ball's worst
+// dihedral angle under the threshold, unless it was there already: by a
+// cusp tip the worst tets of a ball by both measures are needles, fair
+// by their angles, and a move that keeps them as they are could crush
+// another tet to 2° and still count as progress.
+bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation& r, std::vector<TetId>& ball,
+                           double dihedral_threshold) {
   if (r.refusal != modify::Refusal::kNone) return false;
   mesh::collect_ball(m, v, ball);
   const auto before = worst_of(m, ball);
+  const double angle_before = min_dihedral_of(m, ball);
   const Vec3 old = m.coords[v];
   m.coords[v] = r.target;
   const auto after = worst_of(m, ball);
+  const double angle_after = min_dihedral_of(m, ball);
   m.coords[v] = old;
-  return is_progress(before.first, before.second, after.first, after.second);
+  return is_progress(before.first, before.second, after.first, after.second) &&
+         angle_after >= std::min(angle_before, dihedral_threshold);
 }
 
 // What the cusp tips forbid (ImproveOptions::tips): points inside their
@@ -242,10 +256,10 @@ bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::Bou
     if (tips.pinned(v)) continue;
     auto r = o.model ? modify::plan_relocation(ed, cav, *boundary, v, o.model) : modify::plan_relocation(ed, cav, v);
     bool searched = false;
-    if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball)) {
+    if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) {
       if (!search) continue;
       r = plan_searched_relocation(ed, cav, boundary, v, o.model, o.dihedral_threshold);
-      if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball)) continue;
+      if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) continue;
       searched = true;
     }
     modify::apply(ed, cav, v, r);
