@@ -201,7 +201,8 @@ TEST(CuspTips, CapsFollowARingGradedDownToTheStrip) {
 // die out, one on either side (two cusp pairs), over a right-angled corner
 // of the solid. No tip there; every edge's first node at least the span's
 // radius away instead, so the chamfer's triangle at the vertex has opened
-// (7.8 deg worst dihedral angle at hmax 1.2 with the metric's first nodes).
+// (7.8 deg worst dihedral angle at hmax 1.2 with the metric's first nodes),
+// and no chamfer point inside that radius (3.2 deg at hmax 1.0 with them).
 TEST(WedgeSpans, TwoChamfersDyingOutAtAVertexGetLongFirstSegments) {
   const auto model = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/t20_data.step");
   const auto spans = geom::wedge_spans(*model);
@@ -211,28 +212,37 @@ TEST(WedgeSpans, TwoChamfersDyingOutAtAVertexGetLongFirstSegments) {
     at.insert(s.vertex);
     for (const int e : model->upward({0, s.vertex})) EXPECT_LE(s.radius, 0.4 * model->length(e) + 1e-12);
     EXPECT_GT(s.radius, 3.0);  // the metric's first nodes at hmax 1.2: 1.5 to 1.8 away
+    EXPECT_EQ(s.strips.size(), 2u) << "vertex " << s.vertex;
   }
-  size::SizeOptions so;
-  so.hmax = 1.2;
-  const auto size = size::build_size_field(*model, so);
   for (const auto& tip : geom::cusp_tips(*model, [](const Vec3&) { return 1e-3; })) EXPECT_FALSE(at.count(tip.vertex));
-  generate::VolumeMeshStats st;
-  mesh::TetMesh m = generate::mesh_volume(*model, *size.field, {}, &st);
-  EXPECT_TRUE(st.tips.empty());
-  for (const auto& s : spans) {
-    const Vec3 p = model->vertex_point(s.vertex);
-    for (const auto& e : m.edges) {
-      const Vec3 a = m.coords[e.verts[0]], b = m.coords[e.verts[1]];
-      if (a == p || b == p) {
-        EXPECT_GE((a - b).norm(), s.radius * (1 - 1e-6)) << "edge " << e.edge_tag;
+  for (const double hmax : {1.0, 1.2}) {
+    size::SizeOptions so;
+    so.hmax = hmax;
+    const auto size = size::build_size_field(*model, so);
+    generate::VolumeMeshStats st;
+    mesh::TetMesh m = generate::mesh_volume(*model, *size.field, {}, &st);
+    EXPECT_TRUE(st.tips.empty());
+    for (const auto& s : spans) {
+      const Vec3 p = model->vertex_point(s.vertex);
+      for (const auto& e : m.edges) {
+        const Vec3 a = m.coords[e.verts[0]], b = m.coords[e.verts[1]];
+        if (a == p || b == p) {
+          EXPECT_GE((a - b).norm(), s.radius * (1 - 1e-6)) << "edge " << e.edge_tag << " at hmax " << hmax;
+        }
+      }
+      for (VertId v = 0; v < m.num_verts(); ++v) {
+        const auto c = m.vert_class[v];
+        if (c.dim == 2 && std::binary_search(s.strips.begin(), s.strips.end(), c.tag)) {
+          EXPECT_GE((m.coords[v] - p).norm(), s.radius) << "face " << c.tag << " at hmax " << hmax;
+        }
       }
     }
+    optimize::ImproveOptions io;
+    io.model = model.get();
+    optimize::improve_quality(m, io);
+    EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
+    double worst = 180;
+    for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
+    EXPECT_GE(worst, 10.0) << "hmax " << hmax;
   }
-  optimize::ImproveOptions io;
-  io.model = model.get();
-  optimize::improve_quality(m, io);
-  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
-  double worst = 180;
-  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
-  EXPECT_GE(worst, 10.0);
 }

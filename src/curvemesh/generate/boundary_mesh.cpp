@@ -90,7 +90,8 @@ mesh::TetMesh mesh_boundary(const geom::Model& model, const size::SizeField& siz
   BoundaryMeshStats st;
   Timer timer;
   const std::vector<geom::CuspTip> tips = cusp_tips(model, size);
-  const std::vector<EdgeMesh> edges = discretize_edges(model, size, o.edges, tips);
+  const std::vector<geom::WedgeSpan> spans = geom::wedge_spans(model);
+  const std::vector<EdgeMesh> edges = discretize_edges(model, size, o.edges, tips, spans);
   st.edges_seconds = timer.seconds();
   st.cusp_tips = tips.size();
 
@@ -129,8 +130,13 @@ mesh::TetMesh mesh_boundary(const geom::Model& model, const size::SizeField& siz
     at.erase(std::unique(at.begin(), at.end()), at.end());
     for (const int f : at) face_tips[f - 1].push_back(tip);
   }
+  // A wedge span's strips keep out of its ball, with no fan.
+  std::vector<std::vector<geom::CuspTip>> face_spans(nf);
+  for (const geom::WedgeSpan& span : spans)
+    for (const int f : span.strips)
+      face_spans[f - 1].push_back({span.vertex, model.vertex_point(span.vertex), span.radius, {}});
   tbb::parallel_for(1, nf + 1, [&](int f) {
-    faces[f - 1] = mesh_face(model, f, loops[f - 1], size, o.faces, face_tips[f - 1]);
+    faces[f - 1] = mesh_face(model, f, loops[f - 1], size, o.faces, face_tips[f - 1], face_spans[f - 1]);
   });
   st.faces_seconds = timer.seconds();
 

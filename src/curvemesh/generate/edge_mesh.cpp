@@ -139,7 +139,8 @@ std::vector<geom::CuspTip> cusp_tips(const geom::Model& m, const size::SizeField
 }
 
 std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeField& size, const EdgeMeshOptions& o,
-                                       const std::vector<geom::CuspTip>& tips) {
+                                       const std::vector<geom::CuspTip>& tips,
+                                       const std::vector<geom::WedgeSpan>& spans) {
   const int ne = m.count(1);
   // Edges joining the same two vertices need two segments each so that no
   // two mesh edges coincide.
@@ -152,7 +153,7 @@ std::vector<EdgeMesh> discretize_edges(const geom::Model& m, const size::SizeFie
   std::vector<double> tip_of(m.count(0) + 1, 0.0);
   for (const geom::CuspTip& tip : tips) tip_of[tip.vertex] = tip.radius;
   std::vector<double> span_of(m.count(0) + 1, 0.0);
-  for (const geom::WedgeSpan& s : geom::wedge_spans(m)) span_of[s.vertex] = s.radius;
+  for (const geom::WedgeSpan& s : spans) span_of[s.vertex] = s.radius;
   std::vector<EdgeMesh> out(ne);
   tbb::parallel_for(1, ne + 1, [&](int e) {
     const auto v = m.edge_vertices(e);

@@ -60,6 +60,7 @@ std::vector<geom::CuspTip> cusp_tips(const geom::Model& model, const size::SizeF
 
 /// Every edge of the model, in parallel; result[e - 1] is edge e.
 std::vector<EdgeMesh> discretize_edges(const geom::Model& model, const size::SizeField& size,
-                                       const EdgeMeshOptions& options, const std::vector<geom::CuspTip>& tips = {});
+                                       const EdgeMeshOptions& options, const std::vector<geom::CuspTip>& tips = {},
+                                       const std::vector<geom::WedgeSpan>& spans = {});
 
 }  // namespace cm::generate

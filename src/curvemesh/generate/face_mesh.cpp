@@ -21,11 +21,17 @@ namespace {
 constexpr double kHalfSqrt3 = 0.8660254037844386;
 constexpr double kNearFold = 0.17;  // cos 80°: see FaceMesher::folds
 
+std::vector<geom::CuspTip> joined(std::vector<geom::CuspTip> a, const std::vector<geom::CuspTip>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
 class FaceMesher {
  public:
   FaceMesher(const geom::Model& m, int face, const size::SizeField& size, const FaceMeshOptions& o,
-             const std::vector<geom::CuspTip>& tips)
-      : m_(m), face_(face), size_(size), o_(o), tip_list_(tips), tips_(tips), scale_(face_scaling(m, face)),
+             const std::vector<geom::CuspTip>& tips, const std::vector<geom::CuspTip>& keep_out)
+      : m_(m), face_(face), size_(size), o_(o), tip_list_(tips), tips_(joined(tips, keep_out)),
+        scale_(face_scaling(m, face)),
         accepted_(0.5 * o.max_edge) {}
 
   FaceMesh run(const std::vector<std::vector<BoundaryPoint>>& loops) {
@@ -785,8 +791,8 @@ class FaceMesher {
 
 FaceMesh mesh_face(const geom::Model& model, int face, const std::vector<std::vector<BoundaryPoint>>& loops,
                    const size::SizeField& size, const FaceMeshOptions& options,
-                   const std::vector<geom::CuspTip>& tips) {
-  return FaceMesher(model, face, size, options, tips).run(loops);
+                   const std::vector<geom::CuspTip>& tips, const std::vector<geom::CuspTip>& keep_out) {
+  return FaceMesher(model, face, size, options, tips, keep_out).run(loops);
 }
 
 }  // namespace cm::generate

@@ -66,9 +66,11 @@ struct FaceMesh {
 /// Throws cm::GeometryError naming the face when its boundary cannot be
 /// triangulated in (u, v) (self-intersecting p-curves, coincident points).
 /// No interior point goes inside the balls of `tips` (those at the face's
-/// vertices; see geom/cusps.hpp), except to unfold a triangle.
+/// vertices; see geom/cusps.hpp), except to unfold a triangle; nor inside
+/// the balls of `keep_out`, which get none of a tip's fan (a wedge span's
+/// strip).
 FaceMesh mesh_face(const geom::Model& model, int face, const std::vector<std::vector<BoundaryPoint>>& loops,
                    const size::SizeField& size, const FaceMeshOptions& options,
-                   const std::vector<geom::CuspTip>& tips = {});
+                   const std::vector<geom::CuspTip>& tips = {}, const std::vector<geom::CuspTip>& keep_out = {});
 
 }  // namespace cm::generate

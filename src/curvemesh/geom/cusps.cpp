@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 
 namespace cm::geom {
@@ -177,7 +178,17 @@ std::vector<WedgeSpan> wedge_spans(const Model& m) {
       opens = opens && 2 * std::asin(std::min(1.0, 0.5 * (x[0] - x[1]).norm() / radius)) >=
                            0.5 * kCuspDegrees * std::numbers::pi / 180;
     }
-    if (opens) out.push_back({v, radius});
+    if (!opens) continue;
+    std::vector<int> strips;
+    for (const auto& pair : found.pairs) {
+      std::vector<int> a = m.upward({1, pair[0]}), b = m.upward({1, pair[1]});
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(strips));
+    }
+    std::sort(strips.begin(), strips.end());
+    strips.erase(std::unique(strips.begin(), strips.end()), strips.end());
+    out.push_back({v, radius, std::move(strips)});
   }
   return out;
 }

@@ -82,9 +82,13 @@ std::vector<CuspTip> cusp_tips(const Model& model, const std::function<double(co
 /// `radius` from it: the least distance at which every pair's strip has
 /// opened to kCuspDegrees, within the same caps as a tip's radius. No span
 /// where a strip is still under half that angle at the radius.
+/// The strips (the faces between a pair's two edges) get no interior point
+/// within the radius: there the strip is the one triangle on the vertex and
+/// the two first nodes, and a point inside would split it into caps.
 struct WedgeSpan {
   int vertex = 0;
   double radius = 0;
+  std::vector<int> strips;  ///< face tags, sorted
 };
 std::vector<WedgeSpan> wedge_spans(const Model& model);
 
