@@ -87,26 +87,21 @@ std::vector<std::array<bool, 2>> cusp_ends(const Model& m) {
 
 namespace {
 
-// The cusp pairs at a vertex and, over them, the least (`widest` false) or
-// the greatest (true) distance at which a pair's strip is `width` wide.
-struct PairsAt {
-  std::vector<std::array<int, 2>> pairs;
-  double radius = HUGE_VAL;
-};
-
-PairsAt pairs_at(const Model& m, const std::vector<End>& ends, const Vec3& p,
-                 const std::function<double(const Vec3&)>& width, bool widest) {
-  PairsAt out;
-  if (widest) out.radius = 0;
+// The cusp pairs at a vertex, as indices into its ends.
+std::vector<std::array<std::size_t, 2>> pairs_at(const std::vector<End>& ends) {
+  std::vector<std::array<std::size_t, 2>> out;
   for (std::size_t i = 0; i < ends.size(); ++i)
     for (std::size_t j = i + 1; j < ends.size(); ++j)
-      if (ends[i].edge != ends[j].edge && is_cusp_pair(ends[i], ends[j])) {
-        const double r = std::min(tip_length(m, ends[i], ends[j].edge, p, width),
-                                  tip_length(m, ends[j], ends[i].edge, p, width));
-        out.radius = widest ? std::max(out.radius, r) : std::min(out.radius, r);
-        out.pairs.push_back({ends[i].edge, ends[j].edge});
-      }
+      if (ends[i].edge != ends[j].edge && is_cusp_pair(ends[i], ends[j])) out.push_back({i, j});
   return out;
+}
+
+// The distance at which a pair's strip is `width` wide (the nearer of the
+// two edges' answers).
+double pair_length(const Model& m, const std::vector<End>& ends, const std::array<std::size_t, 2>& pair,
+                   const Vec3& p, const std::function<double(const Vec3&)>& width) {
+  const End &a = ends[pair[0]], &b = ends[pair[1]];
+  return std::min(tip_length(m, a, b.edge, p, width), tip_length(m, b, a.edge, p, width));
 }
 
 // What bounds a radius around vertex v: 0.4 times the length of every edge
@@ -141,12 +136,13 @@ std::vector<CuspTip> cusp_tips(const Model& m, const std::function<double(const 
   std::vector<CuspTip> out;
   const auto at = ends_at_vertices(m);
   for (int v = 1; v < static_cast<int>(at.size()); ++v) {
-    const Vec3 p = m.vertex_point(v);
-    PairsAt found = pairs_at(m, at[v], p, width, false);
+    const auto pairs = pairs_at(at[v]);
     // Two faces tapering at one vertex are wedge_spans' business.
-    if (found.pairs.size() != 1) continue;
-    const double radius = capped_radius(m, v, p, found.radius);
-    if (radius > 0 && std::isfinite(radius)) out.push_back({v, p, radius, std::move(found.pairs)});
+    if (pairs.size() != 1) continue;
+    const Vec3 p = m.vertex_point(v);
+    const double radius = capped_radius(m, v, p, pair_length(m, at[v], pairs[0], p, width));
+    if (radius > 0 && std::isfinite(radius))
+      out.push_back({v, p, radius, {{at[v][pairs[0][0]].edge, at[v][pairs[0][1]].edge}}});
   }
   return out;
 }
@@ -156,32 +152,34 @@ std::vector<WedgeSpan> wedge_spans(const Model& m) {
   const auto at = ends_at_vertices(m);
   const double slope = std::tan(kCuspDegrees * std::numbers::pi / 180);
   for (int v = 1; v < static_cast<int>(at.size()); ++v) {
+    const auto pairs = pairs_at(at[v]);
+    if (pairs.size() < 2) continue;
     const Vec3 p = m.vertex_point(v);
     const auto opened = [&](const Vec3& x) { return slope * (x - p).norm(); };
-    const PairsAt found = pairs_at(m, at[v], p, opened, true);
-    if (found.pairs.size() < 2) continue;
-    const double radius = capped_radius(m, v, p, found.radius);
+    double widest = 0;
+    for (const auto& pair : pairs) widest = std::max(widest, pair_length(m, at[v], pair, p, opened));
+    const double radius = capped_radius(m, v, p, widest);
     if (!(radius > 0) || !std::isfinite(radius)) continue;
     // A span that leaves a strip's triangle under half the cusp angle has not
     // opened it, and a long sliver between two nearly collinear segments is
     // what boundary recovery handles worst (a Steiner point splits it, at a
     // quarter of the angle).
     bool opens = true;
-    for (const auto& pair : found.pairs) {
+    for (const auto& pair : pairs) {
       std::array<Vec3, 2> x;
       for (int k = 0; k < 2; ++k) {
-        const int side = m.edge_vertices(pair[k])[0] == v ? 0 : 1;
-        const std::optional<double> u = param_at_distance(m, pair[k], side, radius);
+        const End& end = at[v][pair[k]];
+        const std::optional<double> u = param_at_distance(m, end.edge, end.side, radius);
         opens = opens && u.has_value();
-        if (u) x[k] = m.edge_point(pair[k], *u);
+        if (u) x[k] = m.edge_point(end.edge, *u);
       }
       opens = opens && 2 * std::asin(std::min(1.0, 0.5 * (x[0] - x[1]).norm() / radius)) >=
                            0.5 * kCuspDegrees * std::numbers::pi / 180;
     }
     if (!opens) continue;
     std::vector<int> strips;
-    for (const auto& pair : found.pairs) {
-      std::vector<int> a = m.upward({1, pair[0]}), b = m.upward({1, pair[1]});
+    for (const auto& pair : pairs) {
+      std::vector<int> a = m.upward({1, at[v][pair[0]].edge}), b = m.upward({1, at[v][pair[1]].edge});
       std::sort(a.begin(), a.end());
       std::sort(b.begin(), b.end());
       std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(strips));
