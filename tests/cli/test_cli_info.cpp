@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 
@@ -80,4 +81,37 @@ TEST(CliInfo, BadInputsGiveOneErrorLineAndExitTwo) {
   }
   EXPECT_EQ(run_cli("info").exit_code, 2);
   EXPECT_EQ(run_cli("info --help").exit_code, 0);
+}
+
+// STEP, IGES, the built-ins and the fuse of several solids are plugins loaded
+// on first use (geom_occ/detail/plugin.hpp): a single-solid B-rep needs none,
+// a missing plugin is one clear error, and plugins found through
+// CURVEMESH_PLUGIN_DIR work from anywhere.
+TEST(CliInfo, PluginsLoadOnlyWhenTheInputNeedsThem) {
+  namespace fs = std::filesystem;
+  const std::string empty = cm::test::make_temp_dir("no_plugins");
+  const std::string models = std::string(CM_SHARED_DIR) + "/models/";
+  const std::string without = "env CURVEMESH_PLUGIN_DIR=" + empty + " ";
+  const std::string cli = std::string(CM_CLI_EXECUTABLE) + " ";
+
+  const auto brep = cm::test::run_command(without + cli + "info " + models + "full_sphere.brep");
+  EXPECT_EQ(brep.exit_code, 0) << brep.output;
+
+  const auto step = cm::test::run_command(without + cli + "info " + models + "t20_data.step");
+  EXPECT_EQ(step.exit_code, 3) << step.output;
+  EXPECT_NE(step.output.find("cannot load the STEP reader"), std::string::npos) << step.output;
+  EXPECT_NE(step.output.find(empty), std::string::npos) << "the error names the path tried:\n" << step.output;
+
+  const auto builtin = cm::test::run_command(without + cli + "info builtin:box");
+  EXPECT_EQ(builtin.exit_code, 3) << builtin.output;
+  EXPECT_NE(builtin.output.find("cannot load the built-in shapes"), std::string::npos) << builtin.output;
+
+  // The STEP plugin alone, copied elsewhere, is enough for a STEP model.
+  const fs::path built = fs::path(CM_CLI_EXECUTABLE).parent_path() / "plugins" / "libcurvemesh_occ_step.so";
+  ASSERT_TRUE(fs::exists(built)) << built;
+  const std::string moved = cm::test::make_temp_dir("moved_plugins");
+  fs::copy_file(built, fs::path(moved) / built.filename());
+  const auto relocated = cm::test::run_command("env CURVEMESH_PLUGIN_DIR=" + moved + " " + cli + "info " + models +
+                                               "t20_data.step");
+  EXPECT_EQ(relocated.exit_code, 0) << relocated.output;
 }

@@ -4,14 +4,17 @@
 #include <Standard_Failure.hxx>
 
 #include "curvemesh/core/error.hpp"
+#include "curvemesh/geom_occ/detail/builtin_catalog.hpp"
 #include "curvemesh/geom_occ/detail/occ_model.hpp"
 #include "curvemesh/geom_occ/detail/occ_shapes.hpp"
+#include "curvemesh/geom_occ/detail/plugin.hpp"
 
 namespace cm::geom_occ {
 
 std::unique_ptr<geom::Model> load_model(const std::string& model, const LoadOptions& options) {
   const bool builtin = model.rfind("builtin:", 0) == 0;
-  const detail::ReadShape read = builtin ? detail::make_builtin(model) : detail::read_cad_file(model);
+  const detail::ReadShape read = builtin ? detail::plugin(detail::Plugin::kBuiltin).make_builtin(model)
+                                         : detail::read_cad_file(model);
   const TopoDS_Shape solids = detail::make_conformal_solids(read, options, model);
   try {
     return std::make_unique<detail::OccModel>(solids, read.units);

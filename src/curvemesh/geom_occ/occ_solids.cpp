@@ -4,7 +4,6 @@
 #include <cmath>
 #include <vector>
 
-#include <BOPAlgo_Builder.hxx>
 #include <BRepBuilderAPI_MakeSolid.hxx>
 #include <BRepBuilderAPI_Sewing.hxx>
 #include <BRepCheck_Analyzer.hxx>
@@ -13,7 +12,6 @@
 #include <BRepBndLib.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
-#include <Message_Report.hxx>
 #include <Precision.hxx>
 #include <ShapeFix_Shape.hxx>
 #include <Standard_Failure.hxx>
@@ -27,7 +25,7 @@
 #include <TopoDS_Solid.hxx>
 
 #include "curvemesh/core/error.hpp"
-#include "curvemesh/geom_occ/detail/occ_shapes.hpp"
+#include "curvemesh/geom_occ/detail/plugin.hpp"
 
 namespace cm::geom_occ::detail {
 
@@ -182,22 +180,8 @@ TopoDS_Shape make_conformal_solids(const ReadShape& read, const LoadOptions& opt
       builder.Add(result, solids.front());
       return result;
     }
-    // General fuse: splits the solids against each other and merges coincident
-    // faces, edges and vertices, so touching solids share their interface.
-    BOPAlgo_Builder fuse;
-    for (const TopoDS_Solid& s : solids) fuse.AddArgument(s);
-    fuse.SetRunParallel(false);  // deterministic and polite to the caller's threads
-    fuse.SetFuzzyValue(kFuseFuzz * diagonal_of(shape));
-    fuse.Perform();
-    if (fuse.HasErrors()) {
-      Standard_SStream report;
-      fuse.DumpErrors(report);
-      throw GeometryError(fmt::format("{}: the {} solids cannot be made conformal: {}", source,
-                                      solids.size(), report.str()));
-    }
-    for (TopExp_Explorer ex(fuse.Shape(), TopAbs_SOLID); ex.More(); ex.Next())
-      builder.Add(result, ex.Current());
-    return result;
+    // Several solids: their general fuse, by the plugin that carries TKBO.
+    return plugin(Plugin::kFuse).fuse_solids(solids, kFuseFuzz * diagonal_of(shape), source);
   } catch (const Standard_Failure& e) {
     throw GeometryError(fmt::format("{}: OpenCASCADE failed while preparing the solids: {} ({})",
                                     source, e.GetMessageString(), e.DynamicType()->Name()));

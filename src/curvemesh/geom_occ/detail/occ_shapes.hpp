@@ -19,12 +19,6 @@ struct ReadShape {
 /// Reads a STEP, IGES or B-rep file chosen by extension; throws cm::InputError.
 ReadShape read_cad_file(const std::string& path);
 
-/// Builds "builtin:NAME[:k=v,...]"; throws cm::InputError on a bad spec.
-ReadShape make_builtin(const std::string& spec);
-
-/// The built-ins with parameters and defaults (load.hpp's builtin_help()).
-std::string builtin_help_text();
-
 /// Heals, sews and fuses `read` into a compound of conformal solids (see
 /// load.hpp for the policy). `source` names the model in error messages.
 TopoDS_Shape make_conformal_solids(const ReadShape& read, const LoadOptions& options,

@@ -1,5 +1,5 @@
-// Built-in models made with OCC modelling operations, so tests and examples
-// need no CAD file. Every dimension is a parameter with a default.
+// Plugin: the built-in models (builtin_catalog.hpp), made with OCC modelling
+// operations (TKPrim, TKBool, TKFillet) so tests and examples need no CAD file.
 #include <charconv>
 #include <cmath>
 #include <initializer_list>
@@ -38,60 +38,14 @@
 #include <gp_Vec.hxx>
 
 #include "curvemesh/core/error.hpp"
-#include "curvemesh/geom_occ/detail/occ_shapes.hpp"
+#include "curvemesh/geom_occ/detail/builtin_catalog.hpp"
+#include "curvemesh/geom_occ/detail/plugin.hpp"
 
 namespace cm::geom_occ::detail {
 
 namespace {
 
 using Params = std::map<std::string, double, std::less<>>;
-
-struct Builtin {
-  std::string_view name;
-  std::string_view description;
-  std::vector<std::pair<std::string_view, double>> defaults;
-};
-
-const std::vector<Builtin>& builtins() {
-  static const std::vector<Builtin> kBuiltins = {
-      {"box", "box [0,dx] x [0,dy] x [0,dz]", {{"dx", 1}, {"dy", 1}, {"dz", 1}}},
-      {"sphere", "sphere of radius r centred at the origin", {{"r", 1}}},
-      {"cylinder", "cylinder of radius r and height h on the z axis from z = 0",
-       {{"r", 1}, {"h", 2}}},
-      {"torus", "torus about the z axis: major radius R > minor radius r",
-       {{"R", 2}, {"r", 0.5}}},
-      {"cone", "truncated cone on the z axis: radius r1 at z = 0, r2 at z = h (one may be 0)",
-       {{"r1", 1}, {"r2", 0.5}, {"h", 2}}},
-      {"part",
-       "mechanical part: a 60x40x20 block (times scale) with filleted vertical edges, two "
-       "through holes and a freeform B-spline top face",
-       {{"scale", 1}}},
-      {"blocks",
-       "two regions sharing the face x = dx1: boxes [0,dx1] x [0,dy] x [0,dz] and "
-       "[dx1-o,dx1+dx2] x [0,dy] x [0,dz] (o: an overlap, as of parts that interpenetrate by a hair)",
-       {{"dx1", 1}, {"dx2", 1}, {"dy", 1}, {"dz", 1}, {"o", 0}}},
-      {"inclusion",
-       "two regions: a sphere of radius r inside the cube [-s/2,s/2]^3, and the rest of the cube",
-       {{"s", 2}, {"r", 0.5}}},
-      {"thinwall",
-       "thin-walled tube on the z axis from z = 0 to h: outer radius r, wall thickness t < r",
-       {{"r", 1}, {"t", 0.02}, {"h", 2}}},
-      {"holes",
-       "plate [0,s] x [0,s] x [0,h] with an n x n grid of through holes of radius r, one "
-       "centred in each cell (2r < s/n)",
-       {{"n", 6}, {"s", 1}, {"h", 0.2}, {"r", 0.05}}},
-      {"tangent",
-       "near-tangent faces: the box [0,2] x [0,1] x [0,1] fused with a cylinder of radius r "
-       "along x (x in [0.5,1.5], y = 0.5) sunk d into its top face; the surfaces meet at "
-       "about sqrt(2d/r) radians",
-       {{"r", 0.3}, {"d", 0.001}}},
-      {"smalledges",
-       "small edges: the cube [0,s]^3 with a chamfer of width e on one top edge, a step of "
-       "height e across a third of its top and a notch cube of side e at a bottom corner",
-       {{"s", 1}, {"e", 0.001}}},
-  };
-  return kBuiltins;
-}
 
 Params parse_params(const std::string& spec, const Builtin& b, std::string_view list) {
   Params params;
@@ -222,8 +176,6 @@ TopoDS_Shape make_part(double s) {
   return part;
 }
 
-}  // namespace
-
 ReadShape make_builtin(const std::string& spec) {
   std::string_view rest(spec);
   rest.remove_prefix(std::string_view("builtin:").size());
@@ -315,15 +267,11 @@ ReadShape make_builtin(const std::string& spec) {
   return out;
 }
 
-std::string builtin_help_text() {
-  std::string text;
-  for (const Builtin& b : builtins()) {
-    std::string params;
-    for (const auto& [key, value] : b.defaults)
-      params += fmt::format("{}{}={:g}", params.empty() ? "" : ",", key, value);
-    text += fmt::format("  builtin:{}:{}\n      {}\n", b.name, params, b.description);
-  }
-  return text;
-}
+}  // namespace
 
 }  // namespace cm::geom_occ::detail
+
+extern "C" const cm::geom_occ::detail::PluginTable* CM_OCC_PLUGIN_ENTRY() {
+  static const cm::geom_occ::detail::PluginTable table{.make_builtin = cm::geom_occ::detail::make_builtin};
+  return &table;
+}
