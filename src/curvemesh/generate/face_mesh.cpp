@@ -314,12 +314,14 @@ class FaceMesher {
     if (seed != loc.tri && in_circle(seed)) grow(seed);
     const Vec2 uv = scale_.to_uv(x);
     const geom::SurfaceDerivatives d = m_.face_derivatives(face_, uv);
-    if (crowding) {
-      if (in_tip(d.point)) return -1;
-      for (const int t : cavity_)
-        for (const int v : t_.tris[t])
-          if ((d.point - xyz_[v]).norm() < crowded * h_[v]) return -1;
-    }
+    // Even uncrowded, never where a vertex already is on the surface: the
+    // centroid of a folded sliver can be, and two vertices at one point make
+    // the volume mesh impossible.
+    const double apart = crowding ? crowded : 1e-9;
+    if (crowding && in_tip(d.point)) return -1;
+    for (const int t : cavity_)
+      for (const int v : t_.tris[t])
+        if ((d.point - xyz_[v]).norm() < apart * h_[v]) return -1;
     int id = t_.insert_in_cavity(x, cavity_, &fan);
     if (id < 0) {
       if (loc.kind == Location::kOnEdge && t_.is_constrained(loc.tri, loc.index)) return -1;
@@ -452,7 +454,13 @@ class FaceMesher {
     std::vector<int> fan;
     for (int round = 0; round < 4; ++round) {
       int fixed = 0;
-      for (std::size_t ut = 0; ut < t_.tris.size(); ++ut) {
+      // Only the triangles there at the start of the round: a centroid's
+      // triangles may fold again (a surface folding back within a triangle's
+      // span), and visiting them in the same sweep split them without end
+      // (KiCad's JST_SH connector at hmax 0.138: 23 GB, then killed). They
+      // wait for the next round, and the rounds are bounded.
+      const std::size_t existing = t_.tris.size();
+      for (std::size_t ut = 0; ut < existing; ++ut) {
         const int t = static_cast<int>(ut);
         if (!alive(t)) continue;
         const auto tv = t_.tris[t];
