@@ -14,7 +14,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 printf '%-40s %-8s %10s %9s %8s %8s %6s %8s %6s %8s %8s %8s\n' model size hmax tets seconds opt_s valid steiner vflips minq meanq mindih
 fail=0
-for f in "$models"/*.st[ep]* "$models"/*.brep; do
+for f in "$models"/*.st[ep]* "$models"/*.ig[es]* "$models"/*.brep; do
   [ -f "$f" ] || continue
   name=$(basename "$f")
   "$build/curvemesh" info "$f" --json "$tmp/info.json" >/dev/null 2>&1 || { echo "$name: info failed"; fail=1; continue; }
