@@ -31,8 +31,7 @@ class FaceMesher {
   FaceMesher(const geom::Model& m, int face, const size::SizeField& size, const FaceMeshOptions& o,
              const std::vector<geom::CuspTip>& tips, const std::vector<geom::CuspTip>& keep_out)
       : m_(m), face_(face), size_(size), o_(o), tip_list_(tips), tips_(joined(tips, keep_out)),
-        scale_(face_scaling(m, face)),
-        accepted_(0.5 * o.max_edge) {}
+        scale_(face_scaling(m, face)), accepted_(0.5 * o.max_edge) {}
 
   FaceMesh run(const std::vector<std::vector<BoundaryPoint>>& loops) {
     CdtInput in;
@@ -79,10 +78,9 @@ class FaceMesher {
  private:
   // New points closer than this many sizes to a vertex are refused.
   static constexpr double kCrowded = 0.5;
-  // The same for a tip fan's ring points (split_shell): the front may have
-  // come up to the sphere before the fan is split, and a ring edge left
-  // several sizes long beside a narrow strip makes a needle with a flat
-  // cap triangle (917_fusee at --hmax diagonal/35: 6.1°).
+  // The same for a tip fan's ring points (split_shell): the front may reach
+  // the sphere before the fan is split, and a ring edge left several sizes
+  // long beside a narrow strip makes a needle with a flat cap (fusee: 6.1°).
   static constexpr double kCrowdedOnSphere = 0.25;
   // Balls whose worst triangle is at least this good are smoothed for the
   // sum of qualities, the others for their worst triangle.
@@ -314,9 +312,7 @@ class FaceMesher {
     if (seed != loc.tri && in_circle(seed)) grow(seed);
     const Vec2 uv = scale_.to_uv(x);
     const geom::SurfaceDerivatives d = m_.face_derivatives(face_, uv);
-    // Even uncrowded, never where a vertex already is on the surface: the
-    // centroid of a folded sliver can be, and two vertices at one point make
-    // the volume mesh impossible.
+    // Even uncrowded, never onto a vertex (a folded sliver's centroid can be).
     const double apart = crowding ? crowded : 1e-9;
     if (crowding && in_tip(d.point)) return -1;
     for (const int t : cavity_)
@@ -454,11 +450,8 @@ class FaceMesher {
     std::vector<int> fan;
     for (int round = 0; round < 4; ++round) {
       int fixed = 0;
-      // Only the triangles there at the start of the round: a centroid's
-      // triangles may fold again (a surface folding back within a triangle's
-      // span), and visiting them in the same sweep split them without end
-      // (KiCad's JST_SH connector at hmax 0.138: 23 GB, then killed). They
-      // wait for the next round, and the rounds are bounded.
+      // A centroid's triangles may fold again: split in the same sweep they
+      // went on without end (a KiCad connector, 23 GB); they wait a round.
       const std::size_t existing = t_.tris.size();
       for (std::size_t ut = 0; ut < existing; ++ut) {
         const int t = static_cast<int>(ut);

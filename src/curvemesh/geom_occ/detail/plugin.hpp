@@ -51,6 +51,11 @@ const PluginTable& plugin(Plugin which);
 
 }  // namespace cm::geom_occ::detail
 
-/// The one symbol every plugin exports.
-#define CM_OCC_PLUGIN_ENTRY curvemesh_occ_plugin
+/// The one symbol every plugin exports: CM_OCC_PLUGIN(.read_file = read_step)
+/// defines it, returning a table with those entries.
 #define CM_OCC_PLUGIN_ENTRY_NAME "curvemesh_occ_plugin"
+#define CM_OCC_PLUGIN(...)                                                        \
+  extern "C" const cm::geom_occ::detail::PluginTable* curvemesh_occ_plugin() {     \
+    static const cm::geom_occ::detail::PluginTable table{__VA_ARGS__};             \
+    return &table;                                                                  \
+  }

@@ -271,7 +271,4 @@ ReadShape make_builtin(const std::string& spec) {
 
 }  // namespace cm::geom_occ::detail
 
-extern "C" const cm::geom_occ::detail::PluginTable* CM_OCC_PLUGIN_ENTRY() {
-  static const cm::geom_occ::detail::PluginTable table{.make_builtin = cm::geom_occ::detail::make_builtin};
-  return &table;
-}
+CM_OCC_PLUGIN(.make_builtin = cm::geom_occ::detail::make_builtin)

@@ -38,7 +38,4 @@ TopoDS_Shape fuse_solids(const std::vector<TopoDS_Solid>& solids, double fuzz, c
 
 }  // namespace cm::geom_occ::detail
 
-extern "C" const cm::geom_occ::detail::PluginTable* CM_OCC_PLUGIN_ENTRY() {
-  static const cm::geom_occ::detail::PluginTable table{.fuse_solids = cm::geom_occ::detail::fuse_solids};
-  return &table;
-}
+CM_OCC_PLUGIN(.fuse_solids = cm::geom_occ::detail::fuse_solids)

@@ -91,7 +91,4 @@ ReadShape read_step(const std::string& path) {
 
 }  // namespace cm::geom_occ::detail
 
-extern "C" const cm::geom_occ::detail::PluginTable* CM_OCC_PLUGIN_ENTRY() {
-  static const cm::geom_occ::detail::PluginTable table{.read_file = cm::geom_occ::detail::read_step};
-  return &table;
-}
+CM_OCC_PLUGIN(.read_file = cm::geom_occ::detail::read_step)
