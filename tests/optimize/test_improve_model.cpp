@@ -197,6 +197,51 @@ TEST(VertexSearch, FindsWhatTheLaplacianCannotAndStaysValid) {
   EXPECT_GT(found, laplacian_stuck / 2);
 }
 
+TEST(VertexSearch, KeepsOutOfTipBallsAndSlidesOverTheirSpheres) {
+  // Each interior vertex gets a ball over where the free search would take
+  // it (centred there, the vertex just outside): the search kept out never
+  // ends inside it, and where it still moves, some moves end on the sphere
+  // (polls taken out to it), each valid and within the mean ratio floor.
+  auto m = mesh::make_box_mesh({5, 5, 5}, Vec3(0, 0, 0), Vec3(1, 1, 1), true);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.08, 0.08);
+  for (VertId v = 0; v < m.num_verts(); ++v)
+    if (m.vert_class[v].dim == 3) m.coords[v] += Vec3(u(rng), u(rng), u(rng));
+  modify::MeshEditor ed(m);
+  modify::mark_boundary_faces(ed);
+  modify::Cavity cav;
+  std::vector<TetId> ball;
+  int free_moves = 0, kept_out_moves = 0, on_sphere = 0;
+  for (VertId v = 0; v < m.num_verts(); ++v) {
+    if (m.vert_class[v].dim != 3) continue;
+    const auto free = plan_searched_relocation(ed, cav, nullptr, v, nullptr, 30.0, 40);
+    if (free.refusal != modify::Refusal::kNone) continue;
+    ++free_moves;
+    geom::CuspTip tip;
+    tip.point = free.target;
+    tip.radius = 0.999 * (free.target - m.coords[v]).norm();
+    const geom::TipBalls balls({tip});
+    mesh::collect_ball(m, v, ball);
+    const Worst before = worst_of_ball(m, ball);
+    const auto r = plan_searched_relocation(ed, cav, nullptr, v, nullptr, 30.0, 40, &balls);
+    if (r.refusal == modify::Refusal::kNoImprovement) continue;
+    ASSERT_EQ(r.refusal, modify::Refusal::kNone);
+    const double from_centre = (r.target - tip.point).norm();
+    EXPECT_GE(from_centre, tip.radius) << "vertex " << v;
+    on_sphere += from_centre < tip.radius * (1 + 1e-6);
+    const Vec3 at = m.coords[v];
+    m.coords[v] = r.target;
+    const Worst after = worst_of_ball(m, ball);
+    m.coords[v] = at;
+    EXPECT_GT(after.shape, 0);
+    EXPECT_GE(after.mean_ratio, mean_ratio_floor(before.mean_ratio, before.shape));
+    ++kept_out_moves;
+  }
+  EXPECT_GT(free_moves, 20);
+  EXPECT_GT(kept_out_moves, free_moves / 4);
+  EXPECT_GT(on_sphere, 0);
+}
+
 TEST(VertexSearch, BoundaryVerticesStayOnTheModel) {
   auto r = test::mesh_model("builtin:torus", 0.3);
   auto& m = r.m;

@@ -258,7 +258,7 @@ bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::Bou
     bool searched = false;
     if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) {
       if (!search) continue;
-      r = plan_searched_relocation(ed, cav, boundary, v, o.model, o.dihedral_threshold);
+      r = plan_searched_relocation(ed, cav, boundary, v, o.model, o.dihedral_threshold, 40, &tips.balls);
       if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) continue;
       searched = true;
     }

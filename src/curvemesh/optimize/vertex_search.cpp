@@ -79,7 +79,8 @@ Poll compass_search(const Poll& first, std::span<const Vec3> frame, double h0, i
 
 modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavity& cav,
                                             const modify::BoundaryIndex* boundary, VertId v,
-                                            const geom::Model* model, double angle_goal, int max_polls) {
+                                            const geom::Model* model, double angle_goal, int max_polls,
+                                            const geom::TipBalls* keep_out) {
   auto& m = ed.mesh();
   modify::Relocation refused;
   refused.refusal = modify::Refusal::kClassification;
@@ -139,11 +140,17 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
     Poll p;
     if (dim == 3) {
       p.point = start + offset;
+      if (const geom::CuspTip* tip = keep_out ? keep_out->find(p.point) : nullptr) {
+        const Vec3 ray = p.point - tip->point;
+        if (!(ray.squaredNorm() > 0)) return p;
+        p.point = tip->point + ray * (tip->radius * (1 + 1e-9) / ray.norm());
+      }
     } else {
       const geom::Projection pr = model->closest_point(entity, start + offset, param0);
       p.point = pr.point;
       p.param = pr.param;
     }
+    if (keep_out && keep_out->contains(p.point)) return p;
     rank_at(p);
     return p;
   };

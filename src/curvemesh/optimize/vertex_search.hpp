@@ -21,6 +21,7 @@
 // side and against the model as the boundary check judges them).
 #include <span>
 
+#include "curvemesh/geom/cusps.hpp"
 #include "curvemesh/geom/model.hpp"
 #include "curvemesh/modify/relocate.hpp"
 
@@ -38,10 +39,15 @@ namespace cm::optimize {
 /// plan.before / after are the ball's worst tet_quality (mean ratio) now
 /// and at the target. Costs at most `max_polls` evaluations of the ball
 /// (each, for a boundary vertex, one closest-point query).
+/// With `keep_out` (cusp tips' balls, which hold no point but their vertex)
+/// no poll lands inside a ball: a region vertex's poll there is taken out
+/// to the ball's sphere along the ray from its centre, so a point of a tip's
+/// cap slides over the cap (the moves that reshape the cap's triangles,
+/// whose angles are the needles' dihedral angles); any other is refused.
 modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavity& cavity,
                                             const modify::BoundaryIndex* boundary, VertId v,
                                             const geom::Model* model, double angle_goal = 12,
-                                            int max_polls = 40);
+                                            int max_polls = 40, const geom::TipBalls* keep_out = nullptr);
 
 /// The point x where the worst angle-aware quality of the star of x over
 /// `faces` (a cavity's boundary, each face's normal out of the cavity, as
