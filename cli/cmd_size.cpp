@@ -154,9 +154,10 @@ void add_size_command(CLI::App& app, Runner& runner) {
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
   cmd->footer(
       "Sources are combined by taking the finest, then graded by --hgrad and clamped to [hmin, hmax]\n"
-      "(except along a face tapering to a cusp narrower than hmin: down to hmin / 10).\n"
+      "(except along a face tapering to a cusp narrower than hmin and on a face closed around in under\n"
+      "3 hmin: down to hmin / 10).\n"
       "Cell field 'source' in the .vtu: 0 hmax, 1 face curvature, 2 edge curvature, 3 entity size,\n"
-      "4 size field, 5 gradation, 6 hmin, 7 short edge, 8 narrow face, 9 cusp strip.\n"
+      "4 size field, 5 gradation, 6 hmin, 7 short edge, 8 narrow face, 9 cusp strip, 10 thin closed face.\n"
       "\nExamples:\n  curvemesh size part.step -o size.vtu\n"
       "  curvemesh size builtin:torus --curv-eps 0.01 --hgrad 1.2 -o size.vtu --samples-out samples.vtu\n"
       "  curvemesh size part.step --size face:3=0.5 --size-expr '0.2 + 0.1*abs(z)'\n"

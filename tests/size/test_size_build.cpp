@@ -435,3 +435,26 @@ TEST(SizeBuild, FaceGeometryMatchesTheSeparateQueries) {
   }
   EXPECT_GT(compared, 100);
 }
+
+TEST(SizeBuild, ThinClosedFacesGetThreeSegmentsAroundBelowHmin) {
+  // A pin 8e-3 across and 1 long at hmax 1 (hmin 0.01): at hmin its side
+  // would get fewer than three segments around. It asks for a fifth of
+  // its way around instead; a pin 0.1 across asks for nothing of the kind.
+  const auto thin = geom::make_analytic_cylinder(Vec3::Zero(), Vec3::UnitZ(), 0.004, 1);
+  SizeOptions o;
+  o.hmax = 1;
+  const SizeFieldResult r = build_size_field(*thin, o);
+  const double around = 2 * std::numbers::pi * 0.004;
+  ASSERT_LT(around, 3 * r.hmin);
+  EXPECT_TRUE(std::any_of(r.samples.begin(), r.samples.end(),
+                          [](const SizeSample& s) { return s.source == SizeSource::kThinClosedFace; }));
+  for (const double z : {0.02, 0.5, 0.98}) {
+    const Vec3 x(0.004, 0, z);
+    EXPECT_LE(r.field->size(x, on_face(*thin, 1, x)), around / 3) << "z " << z;
+    EXPECT_GE(r.field->size(x, on_face(*thin, 1, x)), kCuspStripFloor * r.hmin);
+  }
+  const auto pin = geom::make_analytic_cylinder(Vec3::Zero(), Vec3::UnitZ(), 0.05, 1);
+  const SizeFieldResult wide = build_size_field(*pin, o);
+  EXPECT_TRUE(std::none_of(wide.samples.begin(), wide.samples.end(),
+                           [](const SizeSample& s) { return s.source == SizeSource::kThinClosedFace; }));
+}

@@ -144,6 +144,8 @@ SizeFieldResult build_size_field(const geom::Model& model, const SizeOptions& o)
     std::vector<std::vector<SizeSample>> per(nf);
     tbb::parallel_for(1, nf + 1, [&](int f) { per[f - 1] = sample_face_proximity(model, f, r.hmin, r.hmax); });
     for (const auto& v : per) r.samples.insert(r.samples.end(), v.begin(), v.end());
+    tbb::parallel_for(1, nf + 1, [&](int f) { per[f - 1] = sample_thin_closed_face(model, f, r.hmin); });
+    for (const auto& v : per) r.samples.insert(r.samples.end(), v.begin(), v.end());
     const double hmin = r.hmin;
     for (const geom::CuspTip& tip : geom::cusp_tips(model, [hmin](const Vec3&) { return hmin; })) {
       const std::vector<SizeSample> strip = sample_cusp_strips(model, tip, kCuspStripFloor * r.hmin, r.hmax);

@@ -183,8 +183,8 @@ void SizeOctree::insert(const Vec3& x, double h, SizeSource source) {
   if (built_) throw std::logic_error("size octree: insert after build()");
   if (!x.allFinite() || std::isnan(h) || !(h > 0))
     throw std::invalid_argument(fmt::format("size octree: bad request h = {} at ({}, {}, {})", h, x.x(), x.y(), x.z()));
-  const double least = source == SizeSource::kCuspStrip && opt_.cusp_min > 0 ? std::min(opt_.cusp_min, opt_.hmin)
-                                                                              : opt_.hmin;
+  const bool below_hmin = source == SizeSource::kCuspStrip || source == SizeSource::kThinClosedFace;
+  const double least = below_hmin && opt_.cusp_min > 0 ? std::min(opt_.cusp_min, opt_.hmin) : opt_.hmin;
   if (h < least) {
     h = least;
     source = SizeSource::kHmin;

@@ -42,7 +42,7 @@ namespace cm::size {
 
 struct OctreeOptions {
   double hmin = 0;      ///< > 0; sizes below are raised to it
-  /// Requests of source kCuspStrip are raised only to this (<= hmin; 0: hmin).
+  /// Requests of source kCuspStrip or kThinClosedFace are raised only to this (<= hmin; 0: hmin).
   double cusp_min = 0;
   double hmax = 0;      ///< >= hmin; the size where nothing asks for less
   double hgrad = 1.3;   ///< >= 1; growth bound h(b) <= h(a) + (hgrad−1)|ab|

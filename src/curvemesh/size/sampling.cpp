@@ -23,6 +23,7 @@ const char* to_string(SizeSource s) {
     case SizeSource::kShortEdge: return "short edge";
     case SizeSource::kProximity: return "narrow face";
     case SizeSource::kCuspStrip: return "cusp strip";
+    case SizeSource::kThinClosedFace: return "thin closed face";
   }
   return "?";
 }
@@ -442,6 +443,46 @@ std::vector<SizeSample> sample_entity_size(const geom::Model& model, geom::Entit
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   for (const int edge : edges) sample_edge(model, edge, cap, add, h);
   for (const int f : faces) sample_face_interior(model, f, cap, add, h);
+  return out;
+}
+
+// The longest way around a face closed in u or v, measured along the
+// periodic direction at a few stations across the other (a cone's apex
+// makes its way around vanish at one end: the longest is what the face
+// needs segments for); 0 when the face is closed in neither.
+double longest_way_around(const geom::Model& model, int face) {
+  const geom::ParamRange r = model.param_range({2, face});
+  const auto closed = [](double lo, double hi, bool periodic, double period) {
+    return periodic && period > 0 && hi - lo >= period * (1 - 1e-9);
+  };
+  const bool around_u = closed(r.u0, r.u1, r.periodic_u, r.period_u);
+  const bool around_v = closed(r.v0, r.v1, r.periodic_v, r.period_v);
+  if (!around_u && !around_v) return 0;
+  constexpr int kSteps = 24;
+  double longest = 0;
+  for (const double s : {0.1, 0.5, 0.9}) {
+    double length = 0;
+    for (int k = 0; k < kSteps; ++k) {
+      const double t = (k + 0.5) / kSteps;
+      const Vec2 uv = around_u ? Vec2(r.u0 + t * (r.u1 - r.u0), r.v0 + s * (r.v1 - r.v0))
+                               : Vec2(r.u0 + s * (r.u1 - r.u0), r.v0 + t * (r.v1 - r.v0));
+      const geom::SurfaceDerivatives d = model.face_derivatives(face, uv);
+      length += (around_u ? d.du.norm() * (r.u1 - r.u0) : d.dv.norm() * (r.v1 - r.v0)) / kSteps;
+    }
+    if (std::isfinite(length)) longest = std::max(longest, length);
+  }
+  return longest;
+}
+
+std::vector<SizeSample> sample_thin_closed_face(const geom::Model& model, int face, double hmin,
+                                                std::size_t max_points) {
+  const double around = longest_way_around(model, face);
+  if (!(around > 0) || around >= 3 * hmin) return {};
+  const double h = std::max(around / 5, kCuspStripFloor * hmin);
+  if (around < 3 * h) return {};
+  std::vector<SizeSample> out = sample_entity_size(model, {2, face}, h);
+  if (out.size() > max_points) return {};
+  for (SizeSample& sm : out) sm.source = SizeSource::kThinClosedFace;
   return out;
 }
 

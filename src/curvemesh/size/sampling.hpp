@@ -36,6 +36,7 @@ enum class SizeSource : int {
   kShortEdge = 7,       ///< a model edge shorter than the size around it
   kProximity = 8,       ///< two boundary edges of a narrow face close to each other
   kCuspStrip = 9,       ///< the width of a face tapering to a cusp (may be below hmin)
+  kThinClosedFace = 10, ///< a closed face too thin around for three segments at hmin (may be below hmin)
 };
 const char* to_string(SizeSource s);
 
@@ -96,6 +97,17 @@ std::vector<SizeSample> sample_face_proximity(const geom::Model& model, int face
 std::vector<SizeSample> sample_cusp_strips(const geom::Model& model, const geom::CuspTip& tip, double floor,
                                            double hmax);
 inline constexpr double kCuspStripFloor = 0.1;
+
+/// A face closed around (its parameter range one whole period, as a hole's
+/// cylinder) whose way around is shorter than three times hmin would get
+/// fewer than three segments around, and its mesh would close on itself:
+/// a wire 5 um across in a KiCad valve model left the volume mesh invalid.
+/// For such a face, points covering it and its edges asking for a fifth of
+/// the way around, at least kCuspStripFloor hmin; none for any other face,
+/// nor where that floor still leaves fewer than three segments around or
+/// the points would be more than `max_points`.
+std::vector<SizeSample> sample_thin_closed_face(const geom::Model& model, int face, double hmin,
+                                                std::size_t max_points = 200'000);
 
 /// Points covering a vertex, edge or face, or the boundary of a region (its
 /// faces and their edges), with spacing <= h/2 and at most
