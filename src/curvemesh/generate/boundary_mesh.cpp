@@ -51,12 +51,46 @@ int pole_segments(const geom::Model& model, int face, const geom::OrientedUse& u
   return std::clamp(int(std::lround(turned / (std::numbers::pi / 3))) - 1, 1, 64);
 }
 
+// A loop whose uses do not join end to start is an open wire: edges lying
+// inside the face that bound nothing, which a general fuse leaves where two
+// solids touch along a curve (balls on their races in OCCT's
+// Axis_of_bearing sample). Its triangulation would fail later with a
+// message about segments; this one names the cause.
+void require_closed(const geom::Model& model, int face, const std::vector<geom::Loop>& loops) {
+  // The vertex a use starts (last = false) or ends at; 0 for an edge
+  // without vertices.
+  const auto end_of = [&](const geom::OrientedUse& use, bool last) {
+    return model.edge_vertices(use.tag)[use.forward == last ? 1 : 0];
+  };
+  std::size_t open = 0;
+  std::string example;
+  for (const geom::Loop& loop : loops) {
+    const std::size_t n = loop.edges.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const geom::OrientedUse &a = loop.edges[k], &b = loop.edges[(k + 1) % n];
+      const int end = end_of(a, true), start = end_of(b, false);
+      if (end == start || end == 0 || start == 0) continue;
+      if (open++ == 0)
+        example = fmt::format("edge {} ends at vertex {}, the next edge starts at vertex {}", a.tag, end, start);
+      break;
+    }
+  }
+  if (open > 0)
+    throw GeometryError(fmt::format(
+        "face {}: {} of its {} loops are open wires ({}): edges inside the face that bound nothing, as a fuse "
+        "leaves where solids touch along a curve; every face must be bounded by closed loops (separate the touching "
+        "solids, or mesh them one at a time)",
+        face, open, loops.size(), example));
+}
+
 std::vector<std::vector<BoundaryPoint>> face_loops(const geom::Model& model, int face,
                                                    const std::vector<EdgeMesh>& edges,
                                                    const std::vector<std::vector<VertId>>& nodes,
                                                    const mesh::TetMesh& m) {
   std::vector<std::vector<BoundaryPoint>> loops;
-  for (const geom::Loop& loop : model.face_loops(face)) {
+  const std::vector<geom::Loop> model_loops = model.face_loops(face);
+  require_closed(model, face, model_loops);
+  for (const geom::Loop& loop : model_loops) {
     std::vector<BoundaryPoint> pts;
     for (const geom::OrientedUse& use : loop.edges) {
       const EdgeMesh& em = edges[use.tag - 1];

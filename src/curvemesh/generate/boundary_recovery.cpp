@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <tuple>
 #include <unordered_map>
@@ -69,7 +70,7 @@ class Surface {
   /// Splits surface edge (a, b) on its model entity; returns the new vertex.
   /// With `only_face`, an edge inside that face's mesh is split there alone:
   /// the other faces' triangles keep it.
-  VertId split(VertId a, VertId b, RecoveryStats& st, int only_face = 0) {
+  VertId split(VertId a, VertId b, RecoveryStats& st, int only_face, const std::function<bool(const Vec3&)>& taken) {
     const std::uint64_t key = edge_key(a, b);
     // Where to split: the midpoint, except on an edge from an original
     // vertex to a Steiner point, which is split at a power-of-two distance
@@ -84,27 +85,50 @@ class Surface {
       const double d = std::exp2(std::round(std::log2(0.5 * len)));
       w = std::clamp(a_orig ? d / len : 1.0 - d / len, 0.25, 0.75);
     }
-    const Vec3 mid = (1 - w) * m_.coords[a] + w * m_.coords[b];
-    VertId p;
-    if (auto seg = segment_of_.find(key); seg != segment_of_.end() && only_face == 0) {
-      const int e = m_.edges[seg->second].edge_tag;
+    const auto seg = only_face == 0 ? segment_of_.find(key) : segment_of_.end();
+    const int e = seg != segment_of_.end() ? m_.edges[seg->second].edge_tag : 0;
+    int f = only_face;
+    std::optional<Vec2> hint;
+    std::optional<double> ua, ub;
+    if (e != 0) {
       // Halve the parameter interval when both ends have a parameter on the
       // edge: progress is guaranteed even where closest-point projection is
       // ambiguous (tiny or nearly closed edges).
-      const auto ua = param_on_edge(a, e), ub = param_on_edge(b, e, ua);
-      geom::Projection pr;
-      if (ua && ub) {
-        const double u = (1 - w) * *ua + w * *ub;
-        pr.point = model_.edge_point(e, u);
-        pr.param = Vec2(u, 0);
-      } else {
-        std::optional<Vec2> hint;
-        if (ua) hint = Vec2(*ua, 0);
-        if (ub) hint = Vec2(*ub, 0);
-        pr = model_.closest_point({1, e}, mid, hint);
+      ua = param_on_edge(a, e);
+      ub = param_on_edge(b, e, ua);
+      if (ua) hint = Vec2(*ua, 0);
+      if (ub) hint = Vec2(*ub, 0);
+    } else {
+      const auto& around = tris_of_.at(key);
+      if (f == 0) f = m_.tris[around.front()].face_tag;
+      for (std::uint32_t t : around)
+        for (VertId v : m_.tris[t].verts)
+          if (!hint && m_.vert_class[v] == mesh::ModelRef{2, f}) hint = Vec2(m_.vert_param[v].u, m_.vert_param[v].v);
+    }
+    const auto place = [&](double at) {
+      if (e != 0 && ua && ub) {
+        const double u = (1 - at) * *ua + at * *ub;
+        return geom::Projection{model_.edge_point(e, u), Vec2(u, 0), 0};
       }
-      p = m_.add_vert(pr.point);
-      m_.resize_vertex_arrays();
+      const Vec3 mid = (1 - at) * m_.coords[a] + at * m_.coords[b];
+      return e != 0 ? model_.closest_point({1, e}, mid, hint) : model_.closest_point({2, f}, mid, hint);
+    };
+    // Where a face is narrower than the edge is long, closest points clamp
+    // to its trim, and two edges' splits can land on one point (a KiCad
+    // terminal block's face): the next fractions are tried then.
+    geom::Projection pr = place(w);
+    for (const double other : {0.5, 0.375, 0.625, 0.25, 0.75}) {
+      if (!taken(pr.point)) break;
+      pr = place(other);
+    }
+    if (taken(pr.point))
+      throw GeometryError(fmt::format("{} {}: every point tried to split the mesh edge of length {:.3g} at ({:.6g}, "
+                                      "{:.6g}, {:.6g}) lands on a mesh vertex",
+                                      e != 0 ? "edge" : "face", e != 0 ? e : f, (m_.coords[b] - m_.coords[a]).norm(),
+                                      pr.point.x(), pr.point.y(), pr.point.z()));
+    const VertId p = m_.add_vert(pr.point);
+    m_.resize_vertex_arrays();
+    if (e != 0) {
       m_.vert_class[p] = {1, e};
       m_.vert_param[p].u = pr.param.x();
       const std::uint32_t s = seg->second;
@@ -115,15 +139,6 @@ class Surface {
       segment_of_[edge_key(p, b)] = static_cast<std::uint32_t>(m_.edges.size() - 1);
       ++st.steiner_on_edges;
     } else {
-      const auto& around = tris_of_.at(key);
-      const int f = only_face != 0 ? only_face : m_.tris[around.front()].face_tag;
-      std::optional<Vec2> hint;
-      for (std::uint32_t t : around)
-        for (VertId v : m_.tris[t].verts)
-          if (!hint && m_.vert_class[v] == mesh::ModelRef{2, f}) hint = Vec2(m_.vert_param[v].u, m_.vert_param[v].v);
-      const auto pr = model_.closest_point({2, f}, mid, hint);
-      p = m_.add_vert(pr.point);
-      m_.resize_vertex_arrays();
       m_.vert_class[p] = {2, f};
       m_.vert_param[p].u = pr.param.x();
       m_.vert_param[p].v = pr.param.y();
@@ -271,7 +286,18 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   // never a recovered edge or triangle.
   FlipRecovery flips(dt.editor(), [&surf](VertId a, VertId b) { return surf.exists(a, b); });
   auto split_and_insert = [&](VertId a, VertId b, int only_face = 0) {
-    const VertId p = surf.split(a, b, st, only_face);
+    // A point already in the mesh is a vertex of the tet that holds it.
+    const auto taken = [&](const Vec3& x) {
+      try {
+        const TetId t = dt.locate(x, m.vert2tet[a]);
+        for (const VertId v : m.tet2verts[t])
+          if (m.coords[v] == x) return true;
+        return false;
+      } catch (const std::domain_error&) {
+        return false;
+      }
+    };
+    const VertId p = surf.split(a, b, st, only_face, taken);
     // Any flip, even one of a failed attempt, ends Delaunay insertion's
     // assumption that cavities are star-shaped.
     if (flips.stats().face_swaps + flips.stats().edge_removals != 0) dt.set_non_delaunay();
@@ -294,11 +320,18 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
   // mesh to the surfaces, which do not cross, so a few rounds end it.
   std::vector<char> planar(static_cast<std::size_t>(model.count(2)) + 1, 0);
   for (int f = 1; f <= model.count(2); ++f) planar[f] = model.type({2, f}) == geom::ShapeType::kPlane;
+  // Faces that truly intersect cross at every scale: each round then
+  // doubles the pairs (a KiCad transformer's 21k pairs took 16 GB). Rounds
+  // must halve them over any three, as refining toward surfaces that do not
+  // cross does.
+  std::vector<std::size_t> pair_counts;
   for (int round = 0;; ++round) {
     const auto pairs = crossing_triangles(m.coords, m.tris, planar);
     if (round == 0) st.crossing_pairs_initial = pairs.size();
     if (pairs.empty()) break;
-    if (round >= 30) {
+    pair_counts.push_back(pairs.size());
+    const bool stalled = round >= 3 && 2 * pairs.size() > pair_counts[static_cast<std::size_t>(round) - 3];
+    if (round >= 30 || stalled || st.steiner_on_edges + st.steiner_on_faces > max_steiner) {
       const auto& t = m.tris[pairs.front()[0]];
       const auto& u = m.tris[pairs.front()[1]];
       const Vec3 x = m.coords[t.verts[0]];
