@@ -37,6 +37,20 @@ int count_of(const TopoDS_Shape& s, TopAbs_ShapeEnum type) {
   return map.Extent();
 }
 
+// Faces of `s` that lie in no solid of it.
+TopoDS_Compound faces_outside_solids(const TopoDS_Shape& s) {
+  TopTools_IndexedMapOfShape all, in_solids;
+  TopExp::MapShapes(s, TopAbs_FACE, all);
+  for (TopExp_Explorer ex(s, TopAbs_SOLID); ex.More(); ex.Next())
+    TopExp::MapShapes(ex.Current(), TopAbs_FACE, in_solids);
+  TopoDS_Compound out;
+  BRep_Builder builder;
+  builder.MakeCompound(out);
+  for (int i = 1; i <= all.Extent(); ++i)
+    if (!in_solids.Contains(all(i))) builder.Add(out, all(i));
+  return out;
+}
+
 double largest_vertex_tolerance(const TopoDS_Shape& s) {
   double tol = 0;
   for (TopExp_Explorer ex(s, TopAbs_VERTEX); ex.More(); ex.Next())
@@ -170,6 +184,15 @@ TopoDS_Shape make_conformal_solids(const ReadShape& read, const LoadOptions& opt
     std::vector<TopoDS_Solid> solids;
     for (TopExp_Explorer ex(shape, TopAbs_SOLID); ex.More(); ex.Next())
       solids.push_back(TopoDS::Solid(ex.Current()));
+    // Healing an invalid solid can split it into a few closed pieces and
+    // leave the rest of its faces in no solid (a KiCad potentiometer: 3 of
+    // its 53 faces kept): those solids would be meshed and the rest of the
+    // part silently lost. The faces it left out are sewn into solids too.
+    if (const TopoDS_Compound left = faces_outside_solids(shape);
+        !solids.empty() && count_of(left, TopAbs_FACE) > count_of(faces_outside_solids(read.shape), TopAbs_FACE)) {
+      const std::vector<TopoDS_Solid> sewn = sew_into_solids(left, options, tol, source);
+      solids.insert(solids.end(), sewn.begin(), sewn.end());
+    }
     if (solids.empty()) solids = sew_into_solids(shape, options, tol, source);
     check_and_orient(solids, source);
 
