@@ -54,6 +54,17 @@ Worst worst_of_ball(const mesh::TetMesh& m, const std::vector<TetId>& ball) {
   return w;
 }
 
+// The classified unit box of 5^3 cells with its interior vertices moved
+// at random by up to `jitter` (a fifth of a cell is far from flat).
+mesh::TetMesh jittered_box(unsigned seed, double jitter) {
+  auto m = mesh::make_box_mesh({5, 5, 5}, Vec3(0, 0, 0), Vec3(1, 1, 1), true);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-jitter, jitter);
+  for (VertId v = 0; v < m.num_verts(); ++v)
+    if (m.vert_class[v].dim == 3) m.coords[v] += Vec3(u(rng), u(rng), u(rng));
+  return m;
+}
+
 }  // namespace
 
 TEST(ImproveWithModel, BoundaryPointMeshOfASphereLosesItsCapsAndStaysOnTheModel) {
@@ -146,11 +157,7 @@ TEST(VertexSearch, FindsWhatTheLaplacianCannotAndStaysValid) {
   // Interior vertices put at the centroid of their neighbours (where the
   // Laplacian has nowhere to go) in a jittered box: the search still finds
   // better positions, each valid and within the mean ratio floor.
-  auto m = mesh::make_box_mesh({5, 5, 5}, Vec3(0, 0, 0), Vec3(1, 1, 1), true);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(-0.06, 0.06);
-  for (VertId v = 0; v < m.num_verts(); ++v)
-    if (m.vert_class[v].dim == 3) m.coords[v] += Vec3(u(rng), u(rng), u(rng));
+  auto m = jittered_box(3, 0.06);
   modify::MeshEditor ed(m);
   modify::mark_boundary_faces(ed);
   modify::Cavity cav;
@@ -202,11 +209,7 @@ TEST(VertexSearch, KeepsOutOfTipBallsAndSlidesOverTheirSpheres) {
   // it (centred there, the vertex just outside): the search kept out never
   // ends inside it, and where it still moves, some moves end on the sphere
   // (polls taken out to it), each valid and within the mean ratio floor.
-  auto m = mesh::make_box_mesh({5, 5, 5}, Vec3(0, 0, 0), Vec3(1, 1, 1), true);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-0.08, 0.08);
-  for (VertId v = 0; v < m.num_verts(); ++v)
-    if (m.vert_class[v].dim == 3) m.coords[v] += Vec3(u(rng), u(rng), u(rng));
+  auto m = jittered_box(5, 0.08);
   modify::MeshEditor ed(m);
   modify::mark_boundary_faces(ed);
   modify::Cavity cav;

@@ -446,6 +446,8 @@ std::vector<SizeSample> sample_entity_size(const geom::Model& model, geom::Entit
   return out;
 }
 
+namespace {
+
 // The longest way around a face closed in u or v, measured along the
 // periodic direction at a few stations across the other (a cone's apex
 // makes its way around vanish at one end: the longest is what the face
@@ -474,12 +476,15 @@ double longest_way_around(const geom::Model& model, int face) {
   return longest;
 }
 
+}  // namespace
+
 std::vector<SizeSample> sample_thin_closed_face(const geom::Model& model, int face, double hmin,
                                                 std::size_t max_points) {
   const double around = longest_way_around(model, face);
   if (!(around > 0) || around >= 3 * hmin) return {};
   const double h = std::max(around / 5, kCuspStripFloor * hmin);
-  if (around < 3 * h) return {};
+  // Sampling at h/2 spacing puts about 4 area / h² points on the face.
+  if (around < 3 * h || 4 * model.area(face) / (h * h) > static_cast<double>(max_points)) return {};
   std::vector<SizeSample> out = sample_entity_size(model, {2, face}, h);
   if (out.size() > max_points) return {};
   for (SizeSample& sm : out) sm.source = SizeSource::kThinClosedFace;
