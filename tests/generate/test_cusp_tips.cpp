@@ -160,6 +160,30 @@ TEST(CuspTips, MeshKeepsTheBallsEmptyAndTheNeedlesFair) {
   EXPECT_GE(worst, 9.0);
 }
 
+// At run_models.sh's fine size (the bounding-box diagonal / 35) the cap of
+// a tip had two face nodes 0.0027 apart among cap points 0.01 apart. The
+// optimizer first took a cap point off the sphere, then reconnected the cap
+// across the hole into a needle on that short edge (4.98 deg): cap points
+// now move over the sphere only, and a reconnection by a tip must keep the
+// worst dihedral angle.
+TEST(CuspTips, OptimizationKeepsTheCapsWholeAtAFineSize) {
+  const auto& c = crank();
+  const geom::BoundingBox box = c.model->bounding_box();
+  size::SizeOptions so;
+  so.hmax = (box.max - box.min).norm() / 35;
+  const auto size = size::build_size_field(*c.model, so);
+  generate::VolumeMeshStats st;
+  mesh::TetMesh m = generate::mesh_volume(*c.model, *size.field, {}, &st);
+  optimize::ImproveOptions io;
+  io.model = c.model.get();
+  io.tips = st.tips;
+  optimize::improve_quality(m, io);
+  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
+  double worst = 180;
+  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
+  EXPECT_GE(worst, 10.0);
+}
+
 // 917_fusee.stp at a coarse hmax (the bounding-box diagonal / 8): one of its
 // tips is cut short by the model (its strip is still about 30 times
 // narrower than the size where it leaves the ball), so the faces' rings

@@ -7,6 +7,7 @@
 // the mean ratio floor.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <random>
@@ -243,6 +244,33 @@ TEST(VertexSearch, KeepsOutOfTipBallsAndSlidesOverTheirSpheres) {
   EXPECT_GT(free_moves, 20);
   EXPECT_GT(kept_out_moves, free_moves / 4);
   EXPECT_GT(on_sphere, 0);
+}
+
+TEST(VertexSearch, PointsOfATipsCapMoveOverItsSphereOnly) {
+  // Each interior vertex is put on a sphere (a tip's cap point): wherever
+  // the search takes it, it is still on that sphere, and some do move.
+  auto m = jittered_box(5, 0.08);
+  modify::MeshEditor ed(m);
+  modify::mark_boundary_faces(ed);
+  modify::Cavity cav;
+  int moved = 0, tried = 0;
+  for (VertId v = 0; v < m.num_verts(); ++v) {
+    if (m.vert_class[v].dim != 3) continue;
+    geom::CuspTip tip;
+    tip.radius = 0.4;
+    const double k = 0.37 * v;  // a different side of each vertex
+    tip.point = m.coords[v] - tip.radius * Vec3(std::cos(k) * std::sin(1 + k), std::sin(k) * std::sin(1 + k), std::cos(1 + k));
+    const geom::TipBalls balls({tip});
+    ASSERT_NE(balls.sphere_of(m.coords[v]), nullptr);
+    ++tried;
+    const auto r = plan_searched_relocation(ed, cav, nullptr, v, nullptr, 30.0, 40, &balls);
+    if (r.refusal != modify::Refusal::kNone) continue;
+    EXPECT_NEAR((r.target - tip.point).norm(), tip.radius, 1e-6 * tip.radius) << "vertex " << v;
+    EXPECT_GT((r.target - m.coords[v]).norm(), 0);
+    ++moved;
+  }
+  EXPECT_GT(tried, 20);
+  EXPECT_GT(moved, tried / 4);
 }
 
 TEST(VertexSearch, BoundaryVerticesStayOnTheModel) {

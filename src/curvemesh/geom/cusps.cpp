@@ -204,6 +204,21 @@ const CuspTip* TipBalls::find(const Vec3& x) const {
   return nullptr;
 }
 
+const CuspTip* TipBalls::sphere_of(const Vec3& x) const {
+  constexpr double kTolerance = 1e-6;
+  auto it = std::lower_bound(tips_.begin(), tips_.end(), x.x() - 2 * max_radius_,
+                             [](const CuspTip& t, double value) { return t.point.x() < value; });
+  for (; it != tips_.end() && it->point.x() <= x.x() + 2 * max_radius_; ++it)
+    if (std::abs((x - it->point).norm() - it->radius) <= kTolerance * it->radius) return &*it;
+  return nullptr;
+}
+
+Vec3 TipBalls::onto_sphere(const CuspTip& tip, const Vec3& x) {
+  const Vec3 ray = x - tip.point;
+  if (!(ray.squaredNorm() > 0)) return x;
+  return tip.point + ray * (tip.radius * (1 + 1e-9) / ray.norm());
+}
+
 std::optional<double> param_at_distance(const Model& m, int edge, int side, double radius) {
   const ParamRange r = m.param_range({1, edge});
   const Vec3 end = m.edge_point(edge, side == 0 ? r.u0 : r.u1);

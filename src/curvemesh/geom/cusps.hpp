@@ -50,6 +50,12 @@ class TipBalls {
   bool contains(const Vec3& x) const { return find(x) != nullptr; }
   /// The tip whose ball holds x, or null.
   const CuspTip* find(const Vec3& x) const;
+  /// The tip whose sphere x lies on (within 1e-6 of its radius), or null:
+  /// the points of a tip's cap, which must stay on it.
+  const CuspTip* sphere_of(const Vec3& x) const;
+  /// x taken along the ray from the tip's vertex to just outside its sphere
+  /// (the sphere itself counts as outside the ball); x itself at the vertex.
+  static Vec3 onto_sphere(const CuspTip& tip, const Vec3& x);
   bool empty() const { return tips_.empty(); }
 
  private:

@@ -141,11 +141,65 @@ class TetMemo {
   std::size_t used_ = 0;
 };
 
+// What the cusp tips forbid (ImproveOptions::tips): points inside their
+// balls, and moving or collapsing the boundary vertices next to a tip's
+// vertex. The two ends of the strip's first cross edge stay aligned, which
+// keeps the tip's needle from becoming a cap, and the faces' fans keep the
+// fine spacing at the strip that the needles there need (a better mean
+// ratio of the needles around asks for the opposite of both).
+struct TipRules {
+  geom::TipBalls balls;
+  std::vector<char> pinned_, tip_vertex;  // per vertex (empty: no tips)
+  bool pinned(VertId v) const { return v < pinned_.size() && pinned_[v]; }
+  /// Whether any of the tets has a tip's vertex.
+  bool touches(const mesh::TetMesh& m, std::span<const TetId> tets) const {
+    if (tip_vertex.empty()) return false;
+    for (const TetId t : tets)
+      for (const VertId v : m.tet2verts[t])
+        if (v < tip_vertex.size() && tip_vertex[v]) return true;
+    return false;
+  }
+
+  TipRules(const mesh::TetMesh& m, const std::vector<geom::CuspTip>& tips) : balls(tips) {
+    if (tips.empty()) return;
+    pinned_.assign(m.coords.size(), 0);
+    tip_vertex.assign(m.coords.size(), 0);
+    std::vector<TetId> ball;
+    for (VertId v = 0; v < m.coords.size(); ++v) {
+      if (m.vert_class[v].dim != 0) continue;
+      const bool tip = std::any_of(tips.begin(), tips.end(), [&](const geom::CuspTip& c) { return c.vertex == m.vert_class[v].tag; });
+      if (!tip) continue;
+      tip_vertex[v] = 1;
+      mesh::collect_ball(m, v, ball);
+      for (const TetId t : ball)
+        for (const VertId w : m.tet2verts[t])
+          if (m.vert_class[w].dim == 1 || m.vert_class[w].dim == 2) pinned_[w] = 1;
+    }
+  }
+};
+
+// Whether the new tets' worst dihedral angle is no worse than the old ones',
+// or at least the threshold. By a cusp tip the ball's worst tets by the
+// mean ratio are its needles, fair by their angles, and a reconnection that
+// trades a needle for a tet flat across the cap is progress by both
+// measures (relocation_progresses says the same for moves).
+bool keeps_angles(const mesh::TetMesh& m, std::span<const TetId> old_tets, std::span<const modify::NewTet> fill,
+                  double dihedral_threshold) {
+  double before = 180, after = 180;
+  for (const TetId t : old_tets) before = std::min(before, min_dihedral(m, t));
+  for (const auto& nt : fill) {
+    const auto& v = nt.verts;
+    after = std::min(after, quality::tet_min_dihedral(m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]));
+  }
+  return after >= std::min(before, dihedral_threshold);
+}
+
 // The best reconnection of t: for each of its edges the ring triangulation
 // best for the angle-aware measure and the one best for the mean ratio, and
 // the 2-3 swap of each face; progress as is_progress() says, the highest
 // resulting angle-aware quality (then mean ratio) wins.
-bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, ImproveStats& st) {
+bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const TipRules& tips, double dihedral_threshold,
+                   TetId t, ImproveStats& st) {
   const auto& m = ed.mesh();
   int kind = -1, local = 0;
   std::pair<double, double> best{-1, -1};  // (shape, mean ratio) after
@@ -176,6 +230,7 @@ bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, TetId t, Improve
       const auto [mr_b, sh_b] = worst_before;
       const auto [mr_a, sh_a] = worst_after;
       if (!is_progress(mr_b, sh_b, mr_a, sh_a) || std::pair{sh_a, mr_a} <= best) continue;
+      if (tips.touches(m, cav.tets()) && !keeps_angles(m, cav.tets(), p.fill, dihedral_threshold)) continue;
       best = {sh_a, mr_a};
       kind = k;
       local = l;
@@ -215,35 +270,6 @@ bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation&
          angle_after >= std::min(angle_before, dihedral_threshold);
 }
 
-// What the cusp tips forbid (ImproveOptions::tips): points inside their
-// balls, and moving or collapsing the boundary vertices next to a tip's
-// vertex. The two ends of the strip's first cross edge stay aligned, which
-// keeps the tip's needle from becoming a cap, and the faces' fans keep the
-// fine spacing at the strip that the needles there need (a better mean
-// ratio of the needles around asks for the opposite of both).
-struct TipRules {
-  geom::TipBalls balls;
-  std::vector<char> pinned_, tip_vertex;  // per vertex (empty: no tips)
-  bool pinned(VertId v) const { return v < pinned_.size() && pinned_[v]; }
-
-  TipRules(const mesh::TetMesh& m, const std::vector<geom::CuspTip>& tips) : balls(tips) {
-    if (tips.empty()) return;
-    pinned_.assign(m.coords.size(), 0);
-    tip_vertex.assign(m.coords.size(), 0);
-    std::vector<TetId> ball;
-    for (VertId v = 0; v < m.coords.size(); ++v) {
-      if (m.vert_class[v].dim != 0) continue;
-      const bool tip = std::any_of(tips.begin(), tips.end(), [&](const geom::CuspTip& c) { return c.vertex == m.vert_class[v].tag; });
-      if (!tip) continue;
-      tip_vertex[v] = 1;
-      mesh::collect_ball(m, v, ball);
-      for (const TetId t : ball)
-        for (const VertId w : m.tet2verts[t])
-          if (m.vert_class[w].dim == 1 || m.vert_class[w].dim == 2) pinned_[w] = 1;
-    }
-  }
-};
-
 // With a model, boundary vertices move too, on their model entity. The
 // Laplacian move first (cheap, and right for fair balls), else the search.
 bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::BoundaryIndex* boundary,
@@ -255,8 +281,11 @@ bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::Bou
   for (VertId v : tv) {
     if (tips.pinned(v)) continue;
     auto r = o.model ? modify::plan_relocation(ed, cav, *boundary, v, o.model) : modify::plan_relocation(ed, cav, v);
+    // A point of a tip's cap moves only over the cap, which the search
+    // keeps it to; the Laplacian move would take it off.
+    const bool on_cap = m.vert_class[v].dim == 3 && tips.balls.sphere_of(m.coords[v]);
     bool searched = false;
-    if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) {
+    if (on_cap || tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) {
       if (!search) continue;
       r = plan_searched_relocation(ed, cav, boundary, v, o.model, o.dihedral_threshold, 40, &tips.balls);
       if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) continue;
@@ -465,7 +494,7 @@ ImproveStats improve_quality(mesh::TetMesh& m, const ImproveOptions& o) {
       }
       if (o.swaps) {
         Timer op;
-        const bool done = try_reconnect(ed, cav, t, st);
+        const bool done = try_reconnect(ed, cav, tips, o.dihedral_threshold, t, st);
         st.swap_seconds += op.seconds();
         if (done) {
           ++changes;

@@ -136,14 +136,16 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
     for (int k = 0; k < dim; ++k) r += d.dot(frame[static_cast<std::size_t>(k)]) * frame[static_cast<std::size_t>(k)];
     return r;
   };
+  // A point of a tip's cap moves over the cap only: off the sphere, it
+  // leaves a hole in the cap that the needles at the tip's vertex span.
+  const geom::CuspTip* cap = dim == 3 && keep_out ? keep_out->sphere_of(start) : nullptr;
   auto poll_at = [&](const Vec3& offset) {
     Poll p;
     if (dim == 3) {
       p.point = start + offset;
-      if (const geom::CuspTip* tip = keep_out ? keep_out->find(p.point) : nullptr) {
-        const Vec3 ray = p.point - tip->point;
-        if (!(ray.squaredNorm() > 0)) return p;
-        p.point = tip->point + ray * (tip->radius * (1 + 1e-9) / ray.norm());
+      if (const geom::CuspTip* tip = cap ? cap : keep_out ? keep_out->find(p.point) : nullptr) {
+        if (!((p.point - tip->point).squaredNorm() > 0)) return p;
+        p.point = geom::TipBalls::onto_sphere(*tip, p.point);
       }
     } else {
       const geom::Projection pr = model->closest_point(entity, start + offset, param0);
