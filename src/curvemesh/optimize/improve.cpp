@@ -76,10 +76,12 @@ bool needs_work(const mesh::TetMesh& m, TetId t, double q, const ImproveOptions&
 
 double shape(const mesh::TetMesh& m, TetId t) { return angle_aware_measure(m, m.tet2verts[t], nullptr); }
 
-// Worst mean ratio and worst angle-aware quality of a set of tets.
+// Worst mean ratio and worst angle-aware quality of a set of tets (the
+// first is modify::tet_quality's).
 void take_worst(const mesh::TetMesh& m, const std::array<VertId, 4>& v, std::pair<double, double>& w) {
-  w.first = std::min(w.first, modify::tet_quality(m, v));
-  w.second = std::min(w.second, angle_aware_measure(m, v, nullptr));
+  const auto q = mean_ratio_and_shape(m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]);
+  w.first = std::min(w.first, q.first);
+  w.second = std::min(w.second, q.second);
 }
 std::pair<double, double> worst_of(const mesh::TetMesh& m, std::span<const TetId> tets) {
   std::pair<double, double> w{1, 1};
@@ -242,12 +244,6 @@ bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const TipRules& 
   return true;
 }
 
-double min_dihedral_of(const mesh::TetMesh& m, std::span<const TetId> tets) {
-  double w = 180;
-  for (const TetId t : tets) w = std::min(w, min_dihedral(m, t));
-  return w;
-}
-
 // Whether moving v to r.target is progress for its ball (the planners
 // judge the mean ratio; a move that raises it by flattening a sliver
 // elsewhere in the ball is none). Nor may the move take the ball's worst
@@ -259,15 +255,22 @@ bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation&
                            double dihedral_threshold) {
   if (r.refusal != modify::Refusal::kNone) return false;
   mesh::collect_ball(m, v, ball);
-  const auto before = worst_of(m, ball);
-  const double angle_before = min_dihedral_of(m, ball);
+  const auto worst = [&] {
+    TetShape w{1, 1, 180};
+    for (const TetId t : ball) {
+      const auto& tv = m.tet2verts[t];
+      const TetShape q = tet_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
+      w = {std::min(w.mean_ratio, q.mean_ratio), std::min(w.shape, q.shape), std::min(w.min_dihedral, q.min_dihedral)};
+    }
+    return w;
+  };
+  const TetShape before = worst();
   const Vec3 old = m.coords[v];
   m.coords[v] = r.target;
-  const auto after = worst_of(m, ball);
-  const double angle_after = min_dihedral_of(m, ball);
+  const TetShape after = worst();
   m.coords[v] = old;
-  return is_progress(before.first, before.second, after.first, after.second) &&
-         angle_after >= std::min(angle_before, dihedral_threshold);
+  return is_progress(before.mean_ratio, before.shape, after.mean_ratio, after.shape) &&
+         after.min_dihedral >= std::min(before.min_dihedral, dihedral_threshold);
 }
 
 // With a model, boundary vertices move too, on their model entity. The

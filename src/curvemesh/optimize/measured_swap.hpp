@@ -53,6 +53,14 @@ double mean_ratio_floor(double mr_before, double shape_before);
 /// above a floor while raising the second.
 std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
+/// mean_ratio_and_shape with the tet's least dihedral angle (degrees,
+/// quality::tet_min_dihedral, whatever the orientation), which the shape
+/// is computed from: one evaluation where a judge needs all three.
+struct TetShape {
+  double mean_ratio, shape, min_dihedral;
+};
+TetShape tet_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
 /// Whether replacing tets whose worst mean ratio and worst angle-aware
 /// quality are (mr_before, shape_before) by tets with (mr_after,
 /// shape_after) is progress: one of the two rises and the other does not
