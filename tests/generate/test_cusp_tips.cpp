@@ -221,6 +221,40 @@ TEST(CuspTips, CapsFollowARingGradedDownToTheStrip) {
   EXPECT_GE(worst, 10.0);
 }
 
+// 917_fusee.stp has vertices with two cusp pairs (two tangent edges on each
+// side) that no wedge span opens: they get one tip for both pairs. Without
+// it the tets there were the model's worst, 11.0 deg at the default size.
+TEST(CuspTips, TwoPairsThatNoSpanOpensShareOneTip) {
+  const auto model = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/917_fusee.stp");
+  const auto size = size::build_size_field(*model, {});
+  generate::VolumeMeshStats st;
+  mesh::TetMesh m = generate::mesh_volume(*model, *size.field, {}, &st);
+  std::set<int> spanned;
+  for (const auto& s : geom::wedge_spans(*model)) spanned.insert(s.vertex);
+  int shared = 0;
+  for (const auto& tip : st.tips) {
+    if (tip.pairs.size() < 2) continue;
+    ++shared;
+    EXPECT_FALSE(spanned.count(tip.vertex)) << "model vertex " << tip.vertex;
+  }
+  EXPECT_GE(shared, 1);
+  optimize::ImproveOptions io;
+  io.model = model.get();
+  io.tips = st.tips;
+  optimize::improve_quality(m, io);
+  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
+  for (const auto& tip : st.tips)
+    for (VertId v = 0; v < m.num_verts(); ++v) {
+      const double d = (m.coords[v] - tip.point).norm();
+      if (d > 0) {
+        EXPECT_GE(d, tip.radius * (1 - 1e-6)) << "vertex " << v << " in the ball of model vertex " << tip.vertex;
+      }
+    }
+  double worst = 180;
+  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
+  EXPECT_GE(worst, 14.0);
+}
+
 // t20_data.step: at each of its six vertices on the top circle two chamfers
 // die out, one on either side (two cusp pairs), over a right-angled corner
 // of the solid. No tip there; every edge's first node at least the span's

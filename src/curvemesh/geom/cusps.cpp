@@ -130,6 +130,36 @@ double capped_radius(const Model& m, int v, const Vec3& p, double radius) {
   return radius;
 }
 
+// The radius of a wedge span at vertex v with these (two or more) cusp
+// pairs, or 0 where none applies (see wedge_spans).
+double span_radius(const Model& m, int v, const std::vector<End>& ends,
+                   const std::vector<std::array<std::size_t, 2>>& pairs) {
+  const double slope = std::tan(kCuspDegrees * std::numbers::pi / 180);
+  const Vec3 p = m.vertex_point(v);
+  const auto opened = [&](const Vec3& x) { return slope * (x - p).norm(); };
+  double widest = 0;
+  for (const auto& pair : pairs) widest = std::max(widest, pair_length(m, ends, pair, p, opened));
+  const double radius = capped_radius(m, v, p, widest);
+  if (!(radius > 0) || !std::isfinite(radius)) return 0;
+  // A span that leaves a strip's triangle under half the cusp angle has not
+  // opened it, and a long sliver between two nearly collinear segments is
+  // what boundary recovery handles worst (a Steiner point splits it, at a
+  // quarter of the angle).
+  for (const auto& pair : pairs) {
+    std::array<Vec3, 2> x;
+    for (int k = 0; k < 2; ++k) {
+      const End& end = ends[pair[k]];
+      const std::optional<double> u = param_at_distance(m, end.edge, end.side, radius);
+      if (!u) return 0;
+      x[k] = m.edge_point(end.edge, *u);
+    }
+    if (2 * std::asin(std::min(1.0, 0.5 * (x[0] - x[1]).norm() / radius)) <
+        0.5 * kCuspDegrees * std::numbers::pi / 180)
+      return 0;
+  }
+  return radius;
+}
+
 }  // namespace
 
 std::vector<CuspTip> cusp_tips(const Model& m, const std::function<double(const Vec3&)>& width) {
@@ -137,12 +167,20 @@ std::vector<CuspTip> cusp_tips(const Model& m, const std::function<double(const 
   const auto at = ends_at_vertices(m);
   for (int v = 1; v < static_cast<int>(at.size()); ++v) {
     const auto pairs = pairs_at(at[v]);
-    // Two faces tapering at one vertex are wedge_spans' business.
-    if (pairs.size() != 1) continue;
+    // Two faces tapering at one vertex are wedge_spans' business where a
+    // span opens their strips. Where none does (two sharp corners of 4 deg
+    // at one vertex, one on each side of a face between two regions; a
+    // circle tangent to a line on both sides), a tip whose sphere reaches
+    // where the slowest-opening strip is wide enough: without one, the tets
+    // at the vertex were flat (0.4 to 3 deg on unseen models).
+    if (pairs.empty() || (pairs.size() >= 2 && span_radius(m, v, at[v], pairs) > 0)) continue;
     const Vec3 p = m.vertex_point(v);
-    const double radius = capped_radius(m, v, p, pair_length(m, at[v], pairs[0], p, width));
-    if (radius > 0 && std::isfinite(radius))
-      out.push_back({v, p, radius, {{at[v][pairs[0][0]].edge, at[v][pairs[0][1]].edge}}});
+    double length = 0;
+    for (const auto& pair : pairs) length = std::max(length, pair_length(m, at[v], pair, p, width));
+    const double radius = capped_radius(m, v, p, length);
+    CuspTip tip{v, p, radius, {}};
+    for (const auto& pair : pairs) tip.pairs.push_back({at[v][pair[0]].edge, at[v][pair[1]].edge});
+    if (radius > 0 && std::isfinite(radius)) out.push_back(std::move(tip));
   }
   return out;
 }
@@ -150,33 +188,11 @@ std::vector<CuspTip> cusp_tips(const Model& m, const std::function<double(const 
 std::vector<WedgeSpan> wedge_spans(const Model& m) {
   std::vector<WedgeSpan> out;
   const auto at = ends_at_vertices(m);
-  const double slope = std::tan(kCuspDegrees * std::numbers::pi / 180);
   for (int v = 1; v < static_cast<int>(at.size()); ++v) {
     const auto pairs = pairs_at(at[v]);
     if (pairs.size() < 2) continue;
-    const Vec3 p = m.vertex_point(v);
-    const auto opened = [&](const Vec3& x) { return slope * (x - p).norm(); };
-    double widest = 0;
-    for (const auto& pair : pairs) widest = std::max(widest, pair_length(m, at[v], pair, p, opened));
-    const double radius = capped_radius(m, v, p, widest);
-    if (!(radius > 0) || !std::isfinite(radius)) continue;
-    // A span that leaves a strip's triangle under half the cusp angle has not
-    // opened it, and a long sliver between two nearly collinear segments is
-    // what boundary recovery handles worst (a Steiner point splits it, at a
-    // quarter of the angle).
-    bool opens = true;
-    for (const auto& pair : pairs) {
-      std::array<Vec3, 2> x;
-      for (int k = 0; k < 2; ++k) {
-        const End& end = at[v][pair[k]];
-        const std::optional<double> u = param_at_distance(m, end.edge, end.side, radius);
-        opens = opens && u.has_value();
-        if (u) x[k] = m.edge_point(end.edge, *u);
-      }
-      opens = opens && 2 * std::asin(std::min(1.0, 0.5 * (x[0] - x[1]).norm() / radius)) >=
-                           0.5 * kCuspDegrees * std::numbers::pi / 180;
-    }
-    if (!opens) continue;
+    const double radius = span_radius(m, v, at[v], pairs);
+    if (!(radius > 0)) continue;
     std::vector<int> strips;
     for (const auto& pair : pairs) {
       std::vector<int> a = m.upward({1, at[v][pair[0]].edge}), b = m.upward({1, at[v][pair[1]].edge});

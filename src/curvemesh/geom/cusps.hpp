@@ -70,7 +70,9 @@ class TipBalls {
 /// the vertex and 0.8 times the distance to its point half-way by parameter
 /// (so each edge keeps nodes of its own beyond the ball), and at most 0.8
 /// times the distance to any face that does not touch the vertex. A vertex
-/// whose R would be 0 gets no tip, nor one with two pairs (see wedge_spans).
+/// whose R would be 0 gets no tip, nor one with two pairs or more that a
+/// wedge span opens (see wedge_spans); with several pairs and no span, R is
+/// the largest of the pairs' distances.
 std::vector<CuspTip> cusp_tips(const Model& model, const std::function<double(const Vec3&)>& width);
 
 /// Where two faces taper at one vertex (two cusp pairs: on t20_data.step,
