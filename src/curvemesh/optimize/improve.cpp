@@ -251,8 +251,10 @@ bool try_reconnect(modify::MeshEditor& ed, modify::Cavity& cav, const TipRules& 
 // cusp tip the worst tets of a ball by both measures are needles, fair
 // by their angles, and a move that keeps them as they are could crush
 // another tet to 2° and still count as progress.
+// With `needles` (for a point of a tip's cap), the tets at a tip's vertex
+// count by their angles only, as plan_searched_relocation ranks them.
 bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation& r, std::vector<TetId>& ball,
-                           double dihedral_threshold) {
+                           double dihedral_threshold, const TipRules* needles = nullptr) {
   if (r.refusal != modify::Refusal::kNone) return false;
   mesh::collect_ball(m, v, ball);
   const auto worst = [&] {
@@ -260,7 +262,13 @@ bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation&
     for (const TetId t : ball) {
       const auto& tv = m.tet2verts[t];
       const TetShape q = tet_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
-      w = {std::min(w.mean_ratio, q.mean_ratio), std::min(w.shape, q.shape), std::min(w.min_dihedral, q.min_dihedral)};
+      if (needles && needles->touches(m, std::span<const TetId>(&t, 1))) {
+        w.shape = std::min(w.shape, q.shape > 0 ? q.min_dihedral / 70.528779365509308 : -1.0);
+      } else {
+        w.mean_ratio = std::min(w.mean_ratio, q.mean_ratio);
+        w.shape = std::min(w.shape, q.shape);
+      }
+      w.min_dihedral = std::min(w.min_dihedral, q.min_dihedral);
     }
     return w;
   };
@@ -291,7 +299,9 @@ bool try_relocate(modify::MeshEditor& ed, modify::Cavity& cav, const modify::Bou
     if (on_cap || tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) {
       if (!search) continue;
       r = plan_searched_relocation(ed, cav, boundary, v, o.model, o.dihedral_threshold, 40, &tips.balls);
-      if (tips.balls.contains(r.target) || !relocation_progresses(m, v, r, ball, o.dihedral_threshold)) continue;
+      if (tips.balls.contains(r.target) ||
+          !relocation_progresses(m, v, r, ball, o.dihedral_threshold, on_cap ? &tips : nullptr))
+        continue;
       searched = true;
     }
     modify::apply(ed, cav, v, r);

@@ -91,6 +91,18 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
   thread_local std::vector<TetId> ball;
   mesh::collect_ball(m, v, ball);
   const Vec3 start = m.coords[v];
+  // A point of a tip's cap moves over the cap only: off the sphere, it
+  // leaves a hole in the cap that the needles at the tip's vertex span.
+  // The needles (its tets at the tip's vertex) are ranked by their angles
+  // alone, as the driver judges them: their mean ratio is low by design,
+  // and raising it widens the cap triangles whatever their shape.
+  const geom::CuspTip* cap = dim == 3 && keep_out ? keep_out->sphere_of(start) : nullptr;
+  thread_local std::vector<char> needle;
+  needle.assign(ball.size(), 0);
+  if (cap)
+    for (std::size_t i = 0; i < ball.size(); ++i)
+      for (const VertId w : m.tet2verts[ball[i]])
+        needle[i] = needle[i] || m.coords[w] == cap->point;
   // Ranks a position (see Poll), the mean ratio floor being what
   // is_progress keeps the ball's worst at (mean_ratio_floor of its worst
   // now), so the search never leaves what the driver accepts.
@@ -99,11 +111,16 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
   auto rank_at = [&](Poll& p) {
     m.coords[v] = p.point;
     double shape = 1, mr = 1;
-    for (TetId t : ball) {
-      const auto& tv = m.tet2verts[t];
-      const auto q = mean_ratio_and_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
-      mr = std::min(mr, q.first);
-      shape = std::min(shape, q.second);
+    for (std::size_t i = 0; i < ball.size(); ++i) {
+      const auto& tv = m.tet2verts[ball[i]];
+      if (needle[i]) {
+        const TetShape q = tet_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
+        shape = std::min(shape, q.shape > 0 ? q.min_dihedral / kRegularDihedral : -1.0);
+      } else {
+        const auto q = mean_ratio_and_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
+        mr = std::min(mr, q.first);
+        shape = std::min(shape, q.second);
+      }
       if (shape <= 0 || mr < floor) break;
     }
     m.coords[v] = start;
@@ -136,9 +153,6 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
     for (int k = 0; k < dim; ++k) r += d.dot(frame[static_cast<std::size_t>(k)]) * frame[static_cast<std::size_t>(k)];
     return r;
   };
-  // A point of a tip's cap moves over the cap only: off the sphere, it
-  // leaves a hole in the cap that the needles at the tip's vertex span.
-  const geom::CuspTip* cap = dim == 3 && keep_out ? keep_out->sphere_of(start) : nullptr;
   auto poll_at = [&](const Vec3& offset) {
     Poll p;
     if (dim == 3) {

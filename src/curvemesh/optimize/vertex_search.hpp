@@ -44,6 +44,9 @@ namespace cm::optimize {
 /// to the ball's sphere along the ray from its centre, so a point of a tip's
 /// cap slides over the cap (the moves that reshape the cap's triangles,
 /// whose angles are the needles' dihedral angles); any other is refused.
+/// A region vertex on a ball's sphere (a point of its cap) polls only on
+/// that sphere, and its tets at the ball's centre (needles) are ranked by
+/// their smallest dihedral angle alone, outside the mean ratio floor.
 modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavity& cavity,
                                             const modify::BoundaryIndex* boundary, VertId v,
                                             const geom::Model* model, double angle_goal = 12,
