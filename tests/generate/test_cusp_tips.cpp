@@ -41,6 +41,46 @@ double min_dihedral(const mesh::TetMesh& m, TetId t) {
   return *std::min_element(a.begin(), a.end());
 }
 
+double worst_dihedral(const mesh::TetMesh& m) {
+  double worst = 180;
+  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
+  return worst;
+}
+
+// The size field at hmax = the model's bounding-box diagonal / n
+// (run_models.sh's coarse size is n = 8, its fine one n = 35).
+size::SizeFieldResult size_at_diagonal_over(const geom::Model& model, double n) {
+  const geom::BoundingBox box = model.bounding_box();
+  size::SizeOptions so;
+  so.hmax = (box.max - box.min).norm() / n;
+  return size::build_size_field(model, so);
+}
+
+// The volume mesh with its tips (in st), optimized as `curvemesh mesh`
+// does; expected valid.
+mesh::TetMesh optimized_mesh(const geom::Model& model, const size::SizeField& size, generate::VolumeMeshStats& st) {
+  mesh::TetMesh m = generate::mesh_volume(model, size, {}, &st);
+  optimize::ImproveOptions io;
+  io.model = &model;
+  io.tips = st.tips;
+  optimize::improve_quality(m, io);
+  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
+  return m;
+}
+
+// No vertex but a tip's own inside its ball (edge nodes land on the sphere
+// to the edge search's tolerance).
+void expect_balls_empty(const mesh::TetMesh& m, const std::vector<geom::CuspTip>& tips) {
+  for (const auto& tip : tips)
+    for (VertId v = 0; v < m.num_verts(); ++v) {
+      const double d = (m.coords[v] - tip.point).norm();
+      if (d > 0) {
+        EXPECT_GE(d, tip.radius * (1 - 1e-6))
+            << "vertex " << v << " (dim " << m.vert_class[v].dim << ") in the ball of model vertex " << tip.vertex;
+      }
+    }
+}
+
 }  // namespace
 
 TEST(CuspTips, FoundAtTheTaperingFacesAndBoundedByTheModel) {
@@ -121,13 +161,8 @@ TEST(CuspTips, StripSizesFollowTheWidthBelowHmin) {
 TEST(CuspTips, MeshKeepsTheBallsEmptyAndTheNeedlesFair) {
   const auto& c = crank();
   generate::VolumeMeshStats st;
-  mesh::TetMesh m = generate::mesh_volume(*c.model, *c.size.field, {}, &st);
+  const mesh::TetMesh m = optimized_mesh(*c.model, *c.size.field, st);
   ASSERT_EQ(st.tips.size(), 2u);
-  optimize::ImproveOptions io;
-  io.model = c.model.get();
-  io.tips = st.tips;
-  optimize::improve_quality(m, io);
-  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
   for (const auto& tip : st.tips) {
     VertId centre = kNone;
     for (VertId v = 0; v < m.num_verts(); ++v) {
@@ -156,9 +191,7 @@ TEST(CuspTips, MeshKeepsTheBallsEmptyAndTheNeedlesFair) {
     EXPECT_EQ(edges_met.size(), c.model->upward({0, tip.vertex}).size());
     EXPECT_GE(worst, 9.0) << "at model vertex " << tip.vertex;
   }
-  double worst = 180;
-  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
-  EXPECT_GE(worst, 9.0);
+  EXPECT_GE(worst_dihedral(m), 9.0);
 }
 
 // At run_models.sh's fine size (the bounding-box diagonal / 35) the cap of
@@ -169,20 +202,10 @@ TEST(CuspTips, MeshKeepsTheBallsEmptyAndTheNeedlesFair) {
 // worst dihedral angle.
 TEST(CuspTips, OptimizationKeepsTheCapsWholeAtAFineSize) {
   const auto& c = crank();
-  const geom::BoundingBox box = c.model->bounding_box();
-  size::SizeOptions so;
-  so.hmax = (box.max - box.min).norm() / 35;
-  const auto size = size::build_size_field(*c.model, so);
+  const auto size = size_at_diagonal_over(*c.model, 35);
   generate::VolumeMeshStats st;
-  mesh::TetMesh m = generate::mesh_volume(*c.model, *size.field, {}, &st);
-  optimize::ImproveOptions io;
-  io.model = c.model.get();
-  io.tips = st.tips;
-  optimize::improve_quality(m, io);
-  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
-  double worst = 180;
-  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
-  EXPECT_GE(worst, 10.0);
+  const mesh::TetMesh m = optimized_mesh(*c.model, *size.field, st);
+  EXPECT_GE(worst_dihedral(m), 10.0);
 }
 
 // 917_fusee.stp at a coarse hmax (the bounding-box diagonal / 8): one of its
@@ -196,30 +219,12 @@ TEST(CuspTips, OptimizationKeepsTheCapsWholeAtAFineSize) {
 // dihedral angle there was 3.9°.
 TEST(CuspTips, CapsFollowARingGradedDownToTheStrip) {
   const auto model = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/917_fusee.stp");
-  const geom::BoundingBox box = model->bounding_box();
-  size::SizeOptions so;
-  so.hmax = (box.max - box.min).norm() / 8;
-  const auto size = size::build_size_field(*model, so);
+  const auto size = size_at_diagonal_over(*model, 8);
   generate::VolumeMeshStats st;
-  mesh::TetMesh m = generate::mesh_volume(*model, *size.field, {}, &st);
+  const mesh::TetMesh m = optimized_mesh(*model, *size.field, st);
   ASSERT_GE(st.tips.size(), 5u);
-  optimize::ImproveOptions io;
-  io.model = model.get();
-  io.tips = st.tips;
-  optimize::improve_quality(m, io);
-  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
-  for (const auto& tip : st.tips)
-    for (VertId v = 0; v < m.num_verts(); ++v) {
-      const double d = (m.coords[v] - tip.point).norm();
-      if (d > 0) {
-        // Edge nodes land on the sphere to the edge search's tolerance.
-        EXPECT_GE(d, tip.radius * (1 - 1e-6))
-            << "vertex " << v << " (dim " << m.vert_class[v].dim << ") in the ball of model vertex " << tip.vertex;
-      }
-    }
-  double worst = 180;
-  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
-  EXPECT_GE(worst, 10.0);
+  expect_balls_empty(m, st.tips);
+  EXPECT_GE(worst_dihedral(m), 10.0);
 }
 
 // 917_fusee.stp has vertices with two cusp pairs (two tangent edges on each
@@ -229,7 +234,7 @@ TEST(CuspTips, TwoPairsThatNoSpanOpensShareOneTip) {
   const auto model = geom_occ::load_model(std::string(CM_SHARED_DIR) + "/models/917_fusee.stp");
   const auto size = size::build_size_field(*model, {});
   generate::VolumeMeshStats st;
-  mesh::TetMesh m = generate::mesh_volume(*model, *size.field, {}, &st);
+  const mesh::TetMesh m = optimized_mesh(*model, *size.field, st);
   std::set<int> spanned;
   for (const auto& s : geom::wedge_spans(*model)) spanned.insert(s.vertex);
   int shared = 0;
@@ -239,21 +244,8 @@ TEST(CuspTips, TwoPairsThatNoSpanOpensShareOneTip) {
     EXPECT_FALSE(spanned.count(tip.vertex)) << "model vertex " << tip.vertex;
   }
   EXPECT_GE(shared, 1);
-  optimize::ImproveOptions io;
-  io.model = model.get();
-  io.tips = st.tips;
-  optimize::improve_quality(m, io);
-  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
-  for (const auto& tip : st.tips)
-    for (VertId v = 0; v < m.num_verts(); ++v) {
-      const double d = (m.coords[v] - tip.point).norm();
-      if (d > 0) {
-        EXPECT_GE(d, tip.radius * (1 - 1e-6)) << "vertex " << v << " in the ball of model vertex " << tip.vertex;
-      }
-    }
-  double worst = 180;
-  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
-  EXPECT_GE(worst, 14.0);
+  expect_balls_empty(m, st.tips);
+  EXPECT_GE(worst_dihedral(m), 14.0);
 }
 
 // OCCT's CrankArm sample (occt-misc) at the bounding-box diagonal / 35: a
@@ -265,21 +257,11 @@ TEST(CuspTips, CapPointsMoveForTheNeedlesAngles) {
   const char* path = "/usr/share/opencascade/data/occ/CrankArm.brep";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is missing: it comes with Debian's occt-misc";
   const auto model = geom_occ::load_model(path);
-  const geom::BoundingBox box = model->bounding_box();
-  size::SizeOptions so;
-  so.hmax = (box.max - box.min).norm() / 35;
-  const auto size = size::build_size_field(*model, so);
+  const auto size = size_at_diagonal_over(*model, 35);
   generate::VolumeMeshStats st;
-  mesh::TetMesh m = generate::mesh_volume(*model, *size.field, {}, &st);
+  const mesh::TetMesh m = optimized_mesh(*model, *size.field, st);
   ASSERT_FALSE(st.tips.empty());
-  optimize::ImproveOptions io;
-  io.model = model.get();
-  io.tips = st.tips;
-  optimize::improve_quality(m, io);
-  EXPECT_TRUE(mesh::validate(m, mesh::Level::kFull).valid());
-  double worst = 180;
-  for (TetId t = 0; t < m.num_tets(); ++t) worst = std::min(worst, min_dihedral(m, t));
-  EXPECT_GE(worst, 10.0);  // 6.9 before
+  EXPECT_GE(worst_dihedral(m), 10.0);  // 6.9 before
 }
 
 // t20_data.step: at each of its six vertices on the top circle two chamfers

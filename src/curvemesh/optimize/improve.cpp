@@ -153,13 +153,15 @@ struct TipRules {
   geom::TipBalls balls;
   std::vector<char> pinned_, tip_vertex;  // per vertex (empty: no tips)
   bool pinned(VertId v) const { return v < pinned_.size() && pinned_[v]; }
+  /// Whether tet t has a tip's vertex (a needle of its fan).
+  bool at_tip(const mesh::TetMesh& m, TetId t) const {
+    for (const VertId v : m.tet2verts[t])
+      if (v < tip_vertex.size() && tip_vertex[v]) return true;
+    return false;
+  }
   /// Whether any of the tets has a tip's vertex.
   bool touches(const mesh::TetMesh& m, std::span<const TetId> tets) const {
-    if (tip_vertex.empty()) return false;
-    for (const TetId t : tets)
-      for (const VertId v : m.tet2verts[t])
-        if (v < tip_vertex.size() && tip_vertex[v]) return true;
-    return false;
+    return !tip_vertex.empty() && std::any_of(tets.begin(), tets.end(), [&](TetId t) { return at_tip(m, t); });
   }
 
   TipRules(const mesh::TetMesh& m, const std::vector<geom::CuspTip>& tips) : balls(tips) {
@@ -262,8 +264,8 @@ bool relocation_progresses(mesh::TetMesh& m, VertId v, const modify::Relocation&
     for (const TetId t : ball) {
       const auto& tv = m.tet2verts[t];
       const TetShape q = tet_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
-      if (needles && needles->touches(m, std::span<const TetId>(&t, 1))) {
-        w.shape = std::min(w.shape, q.shape > 0 ? q.min_dihedral / 70.528779365509308 : -1.0);
+      if (needles && needles->at_tip(m, t)) {
+        w.shape = std::min(w.shape, needle_shape(q));
       } else {
         w.mean_ratio = std::min(w.mean_ratio, q.mean_ratio);
         w.shape = std::min(w.shape, q.shape);

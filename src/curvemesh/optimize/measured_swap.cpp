@@ -17,7 +17,6 @@ double angle_aware_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Ve
 
 std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return {-1, -1};
-  constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
   const double mr = std::max(quality::tet_mean_ratio(a, b, c, d), 0.0);
   return {mr, std::min(mr, quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral)};
 }
@@ -25,13 +24,12 @@ std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, con
 TetShape tet_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const double angle = quality::tet_min_dihedral(a, b, c, d);
   if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return {-1, -1, angle};
-  constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
   const double mr = std::max(quality::tet_mean_ratio(a, b, c, d), 0.0);
   return {mr, std::min(mr, angle / kRegularDihedral), angle};
 }
 
 double mean_ratio_floor(double mr_before, double shape_before) {
-  constexpr double kTenDegrees = 10.0 / 70.528779365509308;  // angle-aware quality of a 10 degree tet
+  constexpr double kTenDegrees = 10.0 / kRegularDihedral;  // angle-aware quality of a 10 degree tet
   return std::min(mr_before, shape_before < kTenDegrees ? kRescueFloor : kProgressFloor);
 }
 

@@ -22,6 +22,9 @@ namespace cm::optimize {
 /// positive tet, higher is better; <= 0 when not strictly positive.
 using TetMeasure = double (*)(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void* context);
 
+/// The dihedral angle of a regular tet, acos(1/3), in degrees.
+inline constexpr double kRegularDihedral = 70.528779365509308;
+
 /// The shape measure of isotropic improvement: the mean ratio, or the
 /// smallest dihedral angle scaled so a regular tet scores 1
 /// (θ_min / acos(1/3)), whichever is lower; -1 unless strictly positive by
@@ -60,6 +63,11 @@ struct TetShape {
   double mean_ratio, shape, min_dihedral;
 };
 TetShape tet_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+/// The shape of a needle of a cusp tip's fan, which is judged by its angle
+/// alone (its mean ratio is low by design): θ_min / acos(1/3), -1 unless
+/// strictly positive.
+inline double needle_shape(const TetShape& q) { return q.shape > 0 ? q.min_dihedral / kRegularDihedral : -1.0; }
 
 /// Whether replacing tets whose worst mean ratio and worst angle-aware
 /// quality are (mr_before, shape_before) by tets with (mr_after,

@@ -53,7 +53,7 @@ Vec3 star_centroid(const mesh::TetMesh& m, std::span<const modify::CavityFace> f
 // angle-aware quality), point and the refusal.
 // The angle-aware quality of a tet whose smallest dihedral angle is 12
 // degrees: the point search stops short of it (vertex_search.hpp).
-constexpr double kSearchBelow = 12.0 / 70.528779365509308;
+constexpr double kSearchBelow = 12.0 / kRegularDihedral;
 
 void place_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> faces, const Vec3& guess,
                  std::pair<double, double> before, ShellInsertion& plan) {

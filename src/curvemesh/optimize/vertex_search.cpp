@@ -27,8 +27,6 @@ bool better(const Poll& p, const Poll& q, double margin) {
   return p.score > q.score + margin || (p.score >= q.score - 1e-12 && p.tie > q.tie + margin);
 }
 
-constexpr double kRegularDihedral = 70.528779365509308;  // acos(1/3), degrees
-
 // Compass search from `first` (offset 0): each round polls the directions
 // `guided` proposes at the current best, then ± each axis of `frame`, at
 // step h, and moves to the first poll that improves (then on along it, the
@@ -115,7 +113,7 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
       const auto& tv = m.tet2verts[ball[i]];
       if (needle[i]) {
         const TetShape q = tet_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
-        shape = std::min(shape, q.shape > 0 ? q.min_dihedral / kRegularDihedral : -1.0);
+        shape = std::min(shape, needle_shape(q));
       } else {
         const auto q = mean_ratio_and_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
         mr = std::min(mr, q.first);
