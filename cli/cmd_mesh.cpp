@@ -159,12 +159,8 @@ int run_volume(const MeshCliOptions& o) {
   const geom::Model* model = in.model.get();
   const size::SizeFieldResult& sf = in.size;
   const double load_s = in.load_seconds, size_s = in.size_seconds;
-  // The model's volume, for the report, by OpenCASCADE's integration (up
-  // to a fifth of a second): computed meanwhile on the core the mostly
-  // serial meshing leaves idle.
   tbb::task_group background;
   double vol_model = 0;
-  background.run([&] { vol_model = model_volume(*model); });
   // Waited for on every path out, exceptions included: the task reads the model.
   struct Join {
     tbb::task_group& group;
@@ -172,6 +168,10 @@ int run_volume(const MeshCliOptions& o) {
   } join{background};
   generate::VolumeMeshStats st;
   mesh::TetMesh m = generate::mesh_volume(*model, *sf.field, {}, &st);
+  // The model's volume, for the report, by OpenCASCADE's integration (up
+  // to a fifth of a second): computed meanwhile on the core the serial
+  // optimizer leaves idle (the boundary meshing before uses both).
+  background.run([&] { vol_model = model_volume(*model); });
   optimize::ImproveStats opt;
   if (!o.no_optimize) {
     // With the model, boundary vertices move on it: the worst tets of a

@@ -23,6 +23,7 @@
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Shell.hxx>
 #include <TopoDS_Solid.hxx>
+#include <tbb/parallel_for.h>
 
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/geom_occ/detail/plugin.hpp"
@@ -87,7 +88,7 @@ TopoDS_Shape heal(const ReadShape& read, const LoadOptions& options, double tol)
   // Healing a valid shape may still rebuild wires and renumber entities, so
   // valid input is left alone (tags then follow the file); the XSTEP
   // translators already heal what they read.
-  const bool needed = options.heal_tolerance > 0 || !BRepCheck_Analyzer(read.shape).IsValid();
+  const bool needed = options.heal_tolerance > 0 || !BRepCheck_Analyzer(read.shape, Standard_True, Standard_True).IsValid();
   if (!needed) return read.shape;
   ShapeFix_Shape fixer(read.shape);
   fixer.SetPrecision(tol);
@@ -163,11 +164,14 @@ void check_and_orient(std::vector<TopoDS_Solid>& solids, const std::string& sour
         throw GeometryError(fmt::format("{}: solid {}: shell {} is not closed: {}", source, i + 1,
                                         shell_index, describe_free_edge(ex.Current())));
     }
-    // Inside-out solids see the point at infinity inside.
+  }
+  // Inside-out solids see the point at infinity inside. Each solid's
+  // classifier reads only its own shape: the solids in parallel.
+  tbb::parallel_for(std::size_t{0}, solids.size(), [&](std::size_t i) {
     BRepClass3d_SolidClassifier classifier(solids[i]);
     classifier.PerformInfinitePoint(Precision::Confusion());
     if (classifier.State() == TopAbs_IN) solids[i].Reverse();
-  }
+  });
 }
 
 }  // namespace
