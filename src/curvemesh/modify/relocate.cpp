@@ -58,8 +58,23 @@ struct Candidate {
 struct TriBefore {
   Index tri;
   Vec3 normal;
-  bool agrees;  // with its model face
+  // With its model face: -1 until asked. A projection on the model each, the
+  // planners' dearest step, so only for the triangles a candidate's check
+  // reaches (most planned moves find no candidate or fail on the orientation).
+  signed char agrees = -1;
 };
+
+// Whether x agreed with its model face before v moved from `old`.
+bool agreed_before(const mesh::TetMesh& m, const geom::Model& model, TriBefore& x, VertId v, const Vec3& old) {
+  if (x.agrees < 0) {
+    const auto& tv = m.tris[x.tri].verts;
+    std::array<Vec3, 3> p;
+    for (std::size_t k = 0; k < 3; ++k) p[k] = tv[k] == v ? old : m.coords[tv[k]];
+    const int f = m.tris[x.tri].face_tag;
+    x.agrees = agrees_with_model(model, f, p[0], p[1], p[2], check_hint(m, tv, f)) ? 1 : 0;
+  }
+  return x.agrees == 1;
+}
 
 }  // namespace
 
@@ -96,7 +111,7 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
       const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
       const Index i = surf.find_tri(tv[fv[0]], tv[fv[1]], tv[fv[2]]);
       if (i != kNone && std::none_of(tris.begin(), tris.end(), [i](const TriBefore& x) { return x.tri == i; }))
-        tris.push_back({i, Vec3::Zero(), false});
+        tris.push_back({i, Vec3::Zero()});
     }
   }
   centroid /= count;
@@ -147,8 +162,6 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
   for (TriBefore& x : tris) {
     const auto& tv = m.tris[x.tri].verts;
     x.normal = tri_normal(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]]);
-    const int f = m.tris[x.tri].face_tag;
-    x.agrees = agrees_with_model(*model, f, m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], check_hint(m, tv, f));
   }
 
   candidates.clear();
@@ -172,11 +185,11 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
   for (const Candidate& cand : candidates) {
     m.coords[v] = cand.point;
     bool ok = true;
-    for (const TriBefore& x : tris) {
+    for (TriBefore& x : tris) {
       const auto& tri = m.tris[x.tri];
       const Vec3 &a = m.coords[tri.verts[0]], &b = m.coords[tri.verts[1]], &d = m.coords[tri.verts[2]];
       if (!(tri_normal(a, b, d).dot(x.normal) > 0) ||
-          (x.agrees &&
+          (agreed_before(m, *model, x, v, old) &&
            !agrees_with_model(*model, tri.face_tag, a, b, d,
                               check_hint(m, tri.verts, tri.face_tag, v,
                                          c.dim == 2 ? std::optional<Vec2>(cand.param) : std::nullopt)))) {
@@ -224,15 +237,13 @@ Relocation plan_relocation_to(MeshEditor& ed, Cavity& cav, const BoundaryIndex* 
       const auto& fv = mesh::kFaceVerts[static_cast<std::size_t>(f)];
       const Index i = surf->find_tri(tv[fv[0]], tv[fv[1]], tv[fv[2]]);
       if (i != kNone && std::none_of(tris.begin(), tris.end(), [i](const TriBefore& x) { return x.tri == i; }))
-        tris.push_back({i, Vec3::Zero(), false});
+        tris.push_back({i, Vec3::Zero()});
     }
   }
   r.before = min_quality(m, ball);
   for (TriBefore& x : tris) {
     const auto& tv = m.tris[x.tri].verts;
     x.normal = tri_normal(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]]);
-    const int f = m.tris[x.tri].face_tag;
-    x.agrees = agrees_with_model(*model, f, m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], check_hint(m, tv, f));
   }
   const Vec3 old = m.coords[v];
   m.coords[v] = target;
@@ -241,12 +252,12 @@ Relocation plan_relocation_to(MeshEditor& ed, Cavity& cav, const BoundaryIndex* 
   if (!(r.after > 0)) r.refusal = Refusal::kNotStarShaped;
   const std::optional<Vec2> moved_param =
       c.dim == 2 ? std::optional<Vec2>(Vec2(param.u, param.v)) : std::optional<Vec2>();
-  for (const TriBefore& x : tris) {
+  for (TriBefore& x : tris) {
     if (r.refusal != Refusal::kNone) break;
     const auto& tri = m.tris[x.tri];
     const Vec3 &a = m.coords[tri.verts[0]], &b = m.coords[tri.verts[1]], &d = m.coords[tri.verts[2]];
     if (!(tri_normal(a, b, d).dot(x.normal) > 0) ||
-        (x.agrees && !agrees_with_model(*model, tri.face_tag, a, b, d,
+        (agreed_before(m, *model, x, v, old) && !agrees_with_model(*model, tri.face_tag, a, b, d,
                                         check_hint(m, tri.verts, tri.face_tag, v, moved_param))))
       r.refusal = Refusal::kFoldedSurface;
   }
