@@ -21,16 +21,15 @@ double sum_squared_edges(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
          (d - a).squaredNorm() + (d - b).squaredNorm() + (d - c).squaredNorm();
 }
 
-// Cube root of a positive normal double to 7e-15 relative: the exponent
-// divided by three in the bit pattern (2e-2), then two Halley steps (cubic
-// convergence: 2e-5, then 7e-15; a third would gain one digit the quality
-// measures never use). libm's cbrt is correctly rounded and three times
-// slower, and the mean ratio, which needs one, is evaluated millions of
-// times by the optimizer.
+// Cube root of a positive normal double to a few ulps: the exponent divided
+// by three in the bit pattern, then three Halley steps (cubic convergence
+// from a start within a few percent). libm's cbrt is correctly rounded and
+// three times slower, and the mean ratio, which needs one, is evaluated
+// millions of times by the optimizer.
 double cube_root(double x) {
   if (!(x >= std::numeric_limits<double>::min() && x <= std::numeric_limits<double>::max())) return std::cbrt(x);
   double y = std::bit_cast<double>(std::bit_cast<std::uint64_t>(x) / 3 + 0x2a9f7893782da1ceull);
-  for (int k = 0; k < 2; ++k) {
+  for (int k = 0; k < 3; ++k) {
     const double y3 = y * y * y;
     y *= (y3 + 2 * x) / (2 * y3 + x);
   }
