@@ -269,6 +269,15 @@ bool has_face(const mesh::TetMesh& m, VertId a, VertId b, VertId c, std::vector<
   return false;
 }
 
+bool recovery_diverges(std::span<const std::size_t> missing) {
+  constexpr std::size_t kRounds = 4, kFactor = 8;
+  const std::size_t n = missing.size();
+  if (n <= kRounds) return false;
+  for (std::size_t i = n - kRounds; i < n; ++i)
+    if (missing[i] <= missing[i - 1]) return false;
+  return missing.back() > kFactor * std::max<std::size_t>(missing.front(), 1);
+}
+
 RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const RecoveryOptions& o) {
   auto& m = dt.mesh();
   RecoveryStats st;
@@ -379,6 +388,7 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     ~HookReset() { ed.set_hook({}); }
   } hook_reset{ed};
   auto volume_flips_now = [&] { return st.rounds >= o.flips_from_round; };
+  std::vector<std::size_t> missing_counts;  // missing edges and triangles, per round
   for (st.rounds = 0;; ++st.rounds) {
     to_split.clear();
     std::size_t missing_tris = 0;
@@ -488,13 +498,16 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
       return true;
     });
     st.surface_flips += flipped;
-    if (st.rounds >= o.max_rounds || st.steiner_on_edges + st.steiner_on_faces > max_steiner) {
+    missing_counts.push_back(missing_edges + missing_tris);
+    if (st.rounds >= o.max_rounds || st.steiner_on_edges + st.steiner_on_faces > max_steiner ||
+        recovery_diverges(missing_counts)) {
       const auto [a, b] = first_missing;
       const Vec3 x = m.coords[a], y = m.coords[b];
-      throw GeometryError(fmt::format("face {}: boundary recovery did not converge ({} rounds, {} Steiner points, "
+      throw GeometryError(fmt::format("face {}: boundary recovery {} ({} rounds, {} Steiner points, "
                                       "{} edges and {} triangles still missing; one is the edge ({:.6g} {:.6g} "
                                       "{:.6g})-({:.6g} {:.6g} {:.6g}) of length {:.3g})",
-                                      last_face, st.rounds, st.steiner_on_edges + st.steiner_on_faces, missing_edges,
+                                      last_face, recovery_diverges(missing_counts) ? "diverges: its splits make ever more simplices go missing" : "did not converge",
+                                      st.rounds, st.steiner_on_edges + st.steiner_on_faces, missing_edges,
                                       missing_tris, x.x(), x.y(), x.z(), y.x(), y.y(), y.z(), (x - y).norm()));
     }
     if (to_split.empty()) continue;  // only flips this round

@@ -29,6 +29,7 @@
 // not converged after max_rounds or max_steiner points it throws
 // cm::GeometryError naming the model face where recovery failed.
 #include <cstddef>
+#include <span>
 
 #include "curvemesh/generate/delaunay3d.hpp"
 #include "curvemesh/geom/model.hpp"
@@ -65,6 +66,17 @@ struct RecoveryStats {
 /// classified edge an edge of it; tris, edges, coords, vert_class and
 /// vert_param include the Steiner points.
 RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const RecoveryOptions& options = {});
+
+/// Whether recovery's split rounds run away, given the surface edges and
+/// triangles missing at the end of each round so far: the count grew in
+/// each of the last 4 rounds, to more than 8 times the first round's. A
+/// converging recovery shrinks what is missing as its splits reach the local
+/// scale; a runaway one (surfaces touching or crossing below the mesh size)
+/// doubles it each round, splitting edges down to round-off, and would take
+/// minutes to exhaust the Steiner budget before failing anyway (a KiCad
+/// connector: 22 s and 30000 Steiner points; stopped here after 72 rounds,
+/// 2.7 s). recover_boundary throws when this says so.
+bool recovery_diverges(std::span<const std::size_t> missing_per_round);
 
 /// True if (a, b) is an edge of the tetrahedralization (walks a's ball).
 bool has_edge(const mesh::TetMesh& m, VertId a, VertId b, std::vector<TetId>& scratch);
