@@ -1,6 +1,7 @@
 // From the shape as read to a compound of closed, outward-oriented, mutually
 // conformal solids: healing, sewing, solid making and the general fuse.
 #include <algorithm>
+#include <exception>
 #include <cmath>
 #include <vector>
 
@@ -24,6 +25,7 @@
 #include <TopoDS_Shell.hxx>
 #include <TopoDS_Solid.hxx>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/geom_occ/detail/plugin.hpp"
@@ -84,18 +86,27 @@ std::string describe_free_edge(const TopoDS_Shape& shell) {
   return "";
 }
 
-TopoDS_Shape heal(const ReadShape& read, const LoadOptions& options, double tol) {
-  // Healing a valid shape may still rebuild wires and renumber entities, so
-  // valid input is left alone (tags then follow the file); the XSTEP
-  // translators already heal what they read.
-  const bool needed = options.heal_tolerance > 0 || !BRepCheck_Analyzer(read.shape, Standard_True, Standard_True).IsValid();
-  if (!needed) return read.shape;
+// Healing a valid shape may still rebuild wires and renumber entities, so
+// valid input is left alone (tags then follow the file); the XSTEP
+// translators already heal what they read. The analyzer's parallel mode
+// checks sub-shapes on every core.
+bool needs_healing(const ReadShape& read, const LoadOptions& options) {
+  return options.heal_tolerance > 0 || !BRepCheck_Analyzer(read.shape, Standard_True, Standard_True).IsValid();
+}
+
+TopoDS_Shape heal(const ReadShape& read, double tol) {
   ShapeFix_Shape fixer(read.shape);
   fixer.SetPrecision(tol);
   fixer.SetMinTolerance(std::min(tol, Precision::Confusion()));
   fixer.SetMaxTolerance(std::max(tol * 10, 1e-3));
   fixer.Perform();
   return fixer.Shape();
+}
+
+std::vector<TopoDS_Solid> solids_of(const TopoDS_Shape& shape) {
+  std::vector<TopoDS_Solid> solids;
+  for (TopExp_Explorer ex(shape, TopAbs_SOLID); ex.More(); ex.Next()) solids.push_back(TopoDS::Solid(ex.Current()));
+  return solids;
 }
 
 // Solids of an assembly that nearly touch, or overlap by a hair, are fused
@@ -174,6 +185,20 @@ void check_and_orient(std::vector<TopoDS_Solid>& solids, const std::string& sour
   });
 }
 
+// One solid as a compound; several, their general fuse by the plugin that
+// carries TKBO.
+TopoDS_Shape single_or_fused(const std::vector<TopoDS_Solid>& solids, const TopoDS_Shape& shape,
+                             const std::string& source) {
+  if (solids.size() == 1) {
+    TopoDS_Compound result;
+    BRep_Builder builder;
+    builder.MakeCompound(result);
+    builder.Add(result, solids.front());
+    return result;
+  }
+  return plugin(Plugin::kFuse).fuse_solids(solids, kFuseFuzz * diagonal_of(shape), source);
+}
+
 }  // namespace
 
 TopoDS_Shape make_conformal_solids(const ReadShape& read, const LoadOptions& options,
@@ -183,11 +208,27 @@ TopoDS_Shape make_conformal_solids(const ReadShape& read, const LoadOptions& opt
     const double tol = options.heal_tolerance > 0
                            ? options.heal_tolerance
                            : std::max(1e-7, largest_vertex_tolerance(read.shape));
-    const TopoDS_Shape shape = options.heal ? heal(read, options, tol) : read.shape;
+    // Whether healing is needed, and the orientation of the solids as read,
+    // side by side (each reads the shape only): valid input, the usual case,
+    // keeps the solids as read, then already oriented.
+    std::vector<TopoDS_Solid> as_read = solids_of(read.shape);
+    bool healing = false;
+    std::exception_ptr orient_error;
+    tbb::parallel_invoke([&] { healing = options.heal && needs_healing(read, options); },
+                         [&] {
+                           try {
+                             check_and_orient(as_read, source);
+                           } catch (...) {
+                             orient_error = std::current_exception();
+                           }
+                         });
+    if (!healing && !as_read.empty()) {
+      if (orient_error) std::rethrow_exception(orient_error);
+      return single_or_fused(as_read, read.shape, source);
+    }
+    const TopoDS_Shape shape = healing ? heal(read, tol) : read.shape;
 
-    std::vector<TopoDS_Solid> solids;
-    for (TopExp_Explorer ex(shape, TopAbs_SOLID); ex.More(); ex.Next())
-      solids.push_back(TopoDS::Solid(ex.Current()));
+    std::vector<TopoDS_Solid> solids = solids_of(shape);
     // Healing an invalid solid can split it into a few closed pieces and
     // leave the rest of its faces in no solid (a KiCad potentiometer: 3 of
     // its 53 faces kept): those solids would be meshed and the rest of the
@@ -199,16 +240,7 @@ TopoDS_Shape make_conformal_solids(const ReadShape& read, const LoadOptions& opt
     }
     if (solids.empty()) solids = sew_into_solids(shape, options, tol, source);
     check_and_orient(solids, source);
-
-    TopoDS_Compound result;
-    BRep_Builder builder;
-    builder.MakeCompound(result);
-    if (solids.size() == 1) {
-      builder.Add(result, solids.front());
-      return result;
-    }
-    // Several solids: their general fuse, by the plugin that carries TKBO.
-    return plugin(Plugin::kFuse).fuse_solids(solids, kFuseFuzz * diagonal_of(shape), source);
+    return single_or_fused(solids, shape, source);
   } catch (const Standard_Failure& e) {
     throw GeometryError(fmt::format("{}: OpenCASCADE failed while preparing the solids: {} ({})",
                                     source, e.GetMessageString(), e.DynamicType()->Name()));
