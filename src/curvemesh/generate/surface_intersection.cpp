@@ -4,6 +4,10 @@
 #include <cmath>
 #include <cstdint>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 #include "curvemesh/core/predicates.hpp"
 
 namespace cm::generate {
@@ -111,10 +115,9 @@ std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec
         for (auto i2 = c0[2]; i2 <= c1[2]; ++i2)
           entries.emplace_back(static_cast<std::uint64_t>((i2 * dims[1] + i1) * dims[0] + i0), i);
   }
-  std::sort(entries.begin(), entries.end());
-  // A pair sharing several cells is tested once: stamp the partners already
-  // tested against triangle i.
-  std::vector<std::uint32_t> tested(n, UINT32_MAX);
+  tbb::parallel_sort(entries.begin(), entries.end());
+  // Within a cell the entries are in triangle order: each pair is listed
+  // with its first triangle, once per cell they share.
   std::vector<std::vector<std::uint32_t>> partners(n);
   for (std::size_t b = 0; b < entries.size();) {
     std::size_t e = b;
@@ -123,25 +126,34 @@ std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec
       for (std::size_t j = i + 1; j < e; ++j) partners[entries[i].second].push_back(entries[j].second);
     b = e;
   }
+  // Crowded cells (fine triangles among coarse ones) make many candidates:
+  // their boxes once.
+  std::vector<std::array<Vec3, 2>> box(n);
+  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+    const auto& v = tris[i].verts;
+    box[i] = {x[v[0]].cwiseMin(x[v[1]]).cwiseMin(x[v[2]]), x[v[0]].cwiseMax(x[v[1]]).cwiseMax(x[v[2]])};
+  });
   auto box_overlap = [&](std::uint32_t i, std::uint32_t j) {
-    const auto &p = tris[i].verts, &q = tris[j].verts;
-    const Vec3 pl = x[p[0]].cwiseMin(x[p[1]]).cwiseMin(x[p[2]]), ph = x[p[0]].cwiseMax(x[p[1]]).cwiseMax(x[p[2]]);
-    const Vec3 ql = x[q[0]].cwiseMin(x[q[1]]).cwiseMin(x[q[2]]), qh = x[q[0]].cwiseMax(x[q[1]]).cwiseMax(x[q[2]]);
-    return (pl.array() <= qh.array()).all() && (ql.array() <= ph.array()).all();
+    return (box[i][0].array() <= box[j][1].array()).all() && (box[j][0].array() <= box[i][1].array()).all();
   };
-  for (std::uint32_t i = 0; i < n; ++i) {
-    for (std::uint32_t j : partners[i]) {
-      const std::uint32_t a = std::min(i, j), b = std::max(i, j);
-      if (a == b || tested[b] == a) continue;
-      tested[b] = a;
-      if (!box_overlap(a, b)) continue;
-      const auto f = tris[a].face_tag;
-      if (f == tris[b].face_tag && f >= 0 && static_cast<std::size_t>(f) < planar.size() && planar[f]) continue;
-      if (cross(x, tris[a].verts, tris[b].verts)) out.push_back({a, b});
-    }
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  // The exact tests, by first triangle in parallel: each keeps the partners
+  // that cross it, read back in triangle order.
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, static_cast<std::uint32_t>(n), 256),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+                      for (std::uint32_t a = r.begin(); a != r.end(); ++a) {
+                        std::vector<std::uint32_t>& with = partners[a];
+                        std::sort(with.begin(), with.end());
+                        with.erase(std::unique(with.begin(), with.end()), with.end());
+                        const auto f = tris[a].face_tag;
+                        const bool flat = f >= 0 && static_cast<std::size_t>(f) < planar.size() && planar[f];
+                        std::erase_if(with, [&](std::uint32_t b) {
+                          return (flat && tris[b].face_tag == f) || !box_overlap(a, b) ||
+                                 !cross(x, tris[a].verts, tris[b].verts);
+                        });
+                      }
+                    });
+  for (std::uint32_t a = 0; a < n; ++a)
+    for (const std::uint32_t b : partners[a]) out.push_back({a, b});
   return out;
 }
 
