@@ -80,25 +80,37 @@ std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec
   std::vector<std::array<std::uint32_t, 2>> out;
   const std::size_t n = tris.size();
   if (n < 2) return out;
+  std::vector<std::array<Vec3, 2>> box(n);
+  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+    const auto& v = tris[i].verts;
+    box[i] = {x[v[0]].cwiseMin(x[v[1]]).cwiseMin(x[v[2]]), x[v[0]].cwiseMax(x[v[1]]).cwiseMax(x[v[2]])};
+  });
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
   double extent = 0;
-  for (const auto& t : tris) {
-    Vec3 tl = x[t.verts[0]], th = tl;
-    for (VertId v : t.verts) {
-      tl = tl.cwiseMin(x[v]);
-      th = th.cwiseMax(x[v]);
-    }
+  for (const auto& [tl, th] : box) {
     lo = lo.cwiseMin(tl);
     hi = hi.cwiseMax(th);
     extent += (th - tl).maxCoeff();
   }
   // Cells about the size of a mean triangle: each triangle overlaps a few
-  // cells and each cell holds a few triangles. Capped so the grid stays
-  // proportional to the mesh even for very uneven sizes.
+  // cells and each cell holds a few triangles. Only occupied cells count
+  // (they are keys, not an array), so the grid's bound is on the entries: a
+  // bound on all the box's cells made the cells of a long thin model many
+  // triangles wide (917_fusee: 3.4 million candidate pairs for 65k triangles).
   const Vec3 span = (hi - lo).cwiseMax(1e-300);
   double cell = std::max(extent / static_cast<double>(n), 1e-300);
-  const double max_cells = 8.0 * static_cast<double>(n);
-  while ((span / cell).array().ceil().prod() > max_cells) cell *= 1.5;
+  const auto entries_at = [&](double c) {
+    const Eigen::Array3d top = (span / c).array().floor();
+    double total = 0;
+    for (const auto& [tl, th] : box) {
+      const Eigen::Array3d a = ((tl - lo) / c).array().floor().min(top).max(0.0);
+      const Eigen::Array3d b = ((th - lo) / c).array().floor().min(top).max(0.0);
+      total += (b - a + 1).prod();
+    }
+    return total;
+  };
+  // Keys must fit in 64 bits, and the entries stay proportional to the mesh.
+  while ((span / cell).array().ceil().prod() > 1e18 || entries_at(cell) > 12.0 * static_cast<double>(n)) cell *= 1.5;
   const auto dims = ((span / cell).array().floor() + 1).cast<std::int64_t>().eval();
   auto cell_of = [&](const Vec3& p) {
     Eigen::Array<std::int64_t, 3, 1> c = ((p - lo) / cell).array().floor().cast<std::int64_t>();
@@ -107,9 +119,7 @@ std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec
   std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
   entries.reserve(4 * n);
   for (std::uint32_t i = 0; i < n; ++i) {
-    const auto& v = tris[i].verts;
-    const Vec3 tl = x[v[0]].cwiseMin(x[v[1]]).cwiseMin(x[v[2]]), th = x[v[0]].cwiseMax(x[v[1]]).cwiseMax(x[v[2]]);
-    const auto c0 = cell_of(tl), c1 = cell_of(th);
+    const auto c0 = cell_of(box[i][0]), c1 = cell_of(box[i][1]);
     for (auto i0 = c0[0]; i0 <= c1[0]; ++i0)
       for (auto i1 = c0[1]; i1 <= c1[1]; ++i1)
         for (auto i2 = c0[2]; i2 <= c1[2]; ++i2)
@@ -126,13 +136,6 @@ std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec
       for (std::size_t j = i + 1; j < e; ++j) partners[entries[i].second].push_back(entries[j].second);
     b = e;
   }
-  // Crowded cells (fine triangles among coarse ones) make many candidates:
-  // their boxes once.
-  std::vector<std::array<Vec3, 2>> box(n);
-  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-    const auto& v = tris[i].verts;
-    box[i] = {x[v[0]].cwiseMin(x[v[1]]).cwiseMin(x[v[2]]), x[v[0]].cwiseMax(x[v[1]]).cwiseMax(x[v[2]])};
-  });
   auto box_overlap = [&](std::uint32_t i, std::uint32_t j) {
     return (box[i][0].array() <= box[j][1].array()).all() && (box[j][0].array() <= box[i][1].array()).all();
   };
