@@ -182,6 +182,32 @@ TEST_F(OccInputs, TouchingSolidsShareOneInterfaceFace) {
   EXPECT_NEAR(model->volume(1) + model->volume(2), 2, 1e-12);
 }
 
+// Solids stored inside out (their faces' normals pointing in) are turned
+// outward, each on its own, alone or among others that are not.
+TEST_F(OccInputs, InsideOutSolidsAreTurnedOutward) {
+  const TopoDS_Shape inside_out = BRepPrimAPI_MakeBox(1, 1, 1).Shape().Reversed();
+  const auto one = load_model(write_brep("one.brep", inside_out));
+  ASSERT_EQ(one->count(3), 1);
+  EXPECT_NEAR(one->volume(1), 1, 1e-12);
+
+  BRep_Builder builder;
+  TopoDS_Compound three;
+  builder.MakeCompound(three);
+  builder.Add(three, BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 1, 1, 1).Shape().Reversed());
+  builder.Add(three, BRepPrimAPI_MakeBox(gp_Pnt(2, 0, 0), 1, 1, 1).Shape());
+  builder.Add(three, BRepPrimAPI_MakeBox(gp_Pnt(4, 0, 0), 1, 1, 1).Shape().Reversed());
+  const auto model = load_model(write_brep("three.brep", three));
+  ASSERT_EQ(model->count(3), 3);
+  for (int r = 1; r <= 3; ++r) EXPECT_NEAR(model->volume(r), 1, 1e-12) << "region " << r;
+  // Every face's normal points away from its region's centre.
+  for (int f = 1; f <= model->count(2); ++f) {
+    const int r = model->upward({2, f}).front();
+    const geom::ParamRange pr = model->param_range({2, f});
+    const Vec2 mid(0.5 * (pr.u0 + pr.u1), 0.5 * (pr.v0 + pr.v1));
+    EXPECT_GT(model->face_normal(f, mid).dot(model->face_point(f, mid) - model->center_of_mass(r)), 0) << "face " << f;
+  }
+}
+
 TEST_F(OccInputs, OverlappingSolidsSplitIntoTheirPieces) {
   BRep_Builder builder;
   TopoDS_Compound two;
