@@ -3,6 +3,7 @@
 #include "curvemesh/geom_occ/detail/occ_model.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -135,6 +136,8 @@ OccModel::OccModel(const TopoDS_Shape& solids, std::string units) : units_(std::
     box_.add(r.box.max);
   }
   scale_ = std::max(box_.diagonal(), 1e-300);
+  static std::atomic<std::uint64_t> next_serial{1};
+  serial_ = next_serial++;
 }
 
 void OccModel::build_vertices(const TopoDS_Shape& shape, const ShapeMaps& maps) {

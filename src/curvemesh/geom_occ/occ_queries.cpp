@@ -3,6 +3,7 @@
 // at load time and evaluates Geom handles directly (thread-safety argument in
 // detail/occ_model.hpp).
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include <Standard_Failure.hxx>
@@ -54,6 +55,23 @@ bool regular_derivatives(const FaceData& f, int tag, const Vec2& uv,
 
 }  // namespace
 
+namespace {
+
+// Edge meshing asks for an edge's derivatives at u and then, through the
+// size field, for its curvature at the same u (a second D2 evaluation, a
+// third of the edge meshing): the last evaluation of each thread serves
+// both. Keyed by the model's serial number, not its address, which a later
+// model may take.
+struct LastEdgeEvaluation {
+  std::uint64_t model = 0;
+  int edge = 0;
+  double u = 0;
+  geom::CurveDerivatives d;
+};
+thread_local LastEdgeEvaluation t_last_edge;
+
+}  // namespace
+
 geom::CurveDerivatives OccModel::edge_derivatives(int edge, double u) const {
   const EdgeData& e = edge_at(edge);
   if (e.degenerate) {
@@ -68,7 +86,9 @@ geom::CurveDerivatives OccModel::edge_derivatives(int edge, double u) const {
     throw GeometryError(
         fmt::format("edge {}: cannot evaluate at {}: {}", edge, u, ex.GetMessageString()));
   }
-  return {to_vec(p.XYZ()), to_vec(d1.XYZ()), to_vec(d2.XYZ())};
+  const geom::CurveDerivatives d{to_vec(p.XYZ()), to_vec(d1.XYZ()), to_vec(d2.XYZ())};
+  t_last_edge = {serial_, edge, u, d};
+  return d;
 }
 
 geom::SurfaceDerivatives OccModel::face_derivatives(int face, const Vec2& uv) const {
@@ -151,7 +171,9 @@ geom::SurfaceGeometry OccModel::face_geometry(int face, const Vec2& uv) const {
 }
 
 double OccModel::edge_curvature(int edge, double u) const {
-  const geom::CurveDerivatives d = edge_derivatives(edge, u);
+  const LastEdgeEvaluation& last = t_last_edge;
+  const geom::CurveDerivatives d =
+      last.model == serial_ && last.edge == edge && last.u == u ? last.d : edge_derivatives(edge, u);
   const double speed = d.d1.norm();
   if (speed <= 0) return 0;
   return d.d1.cross(d.d2).norm() / (speed * speed * speed);

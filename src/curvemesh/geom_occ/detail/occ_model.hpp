@@ -26,6 +26,7 @@
 // region, so face_normal, face_loops and the p-curves agree with that
 // region's outward normal; region_faces marks a use forward when the region
 // sees the face that way.
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -269,6 +270,7 @@ class OccModel final : public geom::Model {
   std::unique_ptr<Lazy<RegionMesh>[]> region_meshes_;
   geom::BoundingBox box_;
   double scale_ = 1;  // model bounding-box diagonal: the length scale of iteration tolerances
+  std::uint64_t serial_ = 0;  // distinct for every model made in the process (edge_curvature's memo)
   std::string units_;
 };
 
