@@ -499,14 +499,14 @@ RecoveryStats recover_boundary(const geom::Model& model, Delaunay3d& dt, const R
     });
     st.surface_flips += flipped;
     missing_counts.push_back(missing_edges + missing_tris);
-    if (st.rounds >= o.max_rounds || st.steiner_on_edges + st.steiner_on_faces > max_steiner ||
-        recovery_diverges(missing_counts)) {
+    const bool diverges = recovery_diverges(missing_counts);
+    if (st.rounds >= o.max_rounds || st.steiner_on_edges + st.steiner_on_faces > max_steiner || diverges) {
       const auto [a, b] = first_missing;
       const Vec3 x = m.coords[a], y = m.coords[b];
       throw GeometryError(fmt::format("face {}: boundary recovery {} ({} rounds, {} Steiner points, "
                                       "{} edges and {} triangles still missing; one is the edge ({:.6g} {:.6g} "
                                       "{:.6g})-({:.6g} {:.6g} {:.6g}) of length {:.3g})",
-                                      last_face, recovery_diverges(missing_counts) ? "diverges: its splits make ever more simplices go missing" : "did not converge",
+                                      last_face, diverges ? "diverges: its splits make ever more simplices go missing" : "did not converge",
                                       st.rounds, st.steiner_on_edges + st.steiner_on_faces, missing_edges,
                                       missing_tris, x.x(), x.y(), x.z(), y.x(), y.y(), y.z(), (x - y).norm()));
     }

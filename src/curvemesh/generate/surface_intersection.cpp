@@ -110,14 +110,18 @@ std::vector<std::array<std::uint32_t, 2>> crossing_triangles(std::span<const Vec
     return total;
   };
   // Keys must fit in 64 bits, and the entries stay proportional to the mesh.
-  while ((span / cell).array().ceil().prod() > 1e18 || entries_at(cell) > 12.0 * static_cast<double>(n)) cell *= 1.5;
+  double entry_count = entries_at(cell);
+  while ((span / cell).array().ceil().prod() > 1e18 || entry_count > 12.0 * static_cast<double>(n)) {
+    cell *= 1.5;
+    entry_count = entries_at(cell);
+  }
   const auto dims = ((span / cell).array().floor() + 1).cast<std::int64_t>().eval();
   auto cell_of = [&](const Vec3& p) {
     Eigen::Array<std::int64_t, 3, 1> c = ((p - lo) / cell).array().floor().cast<std::int64_t>();
     return c.min(dims - 1).max(0).eval();
   };
   std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
-  entries.reserve(4 * n);
+  entries.reserve(static_cast<std::size_t>(entry_count));
   for (std::uint32_t i = 0; i < n; ++i) {
     const auto c0 = cell_of(box[i][0]), c1 = cell_of(box[i][1]);
     for (auto i0 = c0[0]; i0 <= c1[0]; ++i0)

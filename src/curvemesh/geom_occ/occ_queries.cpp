@@ -53,10 +53,6 @@ bool regular_derivatives(const FaceData& f, int tag, const Vec2& uv,
   return false;
 }
 
-}  // namespace
-
-namespace {
-
 // Edge meshing asks for an edge's derivatives at u and then, through the
 // size field, for its curvature at the same u (a second D2 evaluation, a
 // third of the edge meshing): the last evaluation of each thread serves
