@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "curvemesh/optimize/adapt.hpp"
 #include "curvemesh/optimize/boundary_limit.hpp"
 #include "curvemesh/optimize/improve.hpp"
+#include "curvemesh/optimize/measured_swap.hpp"
 #include "perturbed_box.hpp"
 
 using namespace cm;
@@ -302,4 +304,36 @@ TEST(BoundaryLimit, AThinFaceHasAPriceAtTheTarget) {
     held += w.price < w.mean_ratio;
   }
   EXPECT_EQ(held, l.held_by_thin_face);
+}
+
+// The searches fold each tet into a running minimum through cheap bounds;
+// the result must be the very bits of the plain minimum of
+// mean_ratio_and_shape, or the optimizer's path would change. Stars of a
+// moving point over random fans: fair tets, slivers, needles, inverted.
+TEST(MeasuredSwap, FoldingIsThePlainMinimumBitForBit) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int lowered_late = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    std::pair<double, double> plain{1, 1}, folded{1, 1};
+    const Vec3 x(0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng));
+    for (int k = 0; k < 24; ++k) {
+      std::array<Vec3, 3> f;
+      for (auto& p : f) p = Vec3(u(rng), u(rng), u(rng));
+      if (trial % 5 == 1 && k == 7) f[2] = (f[0] + f[1]) / 2 + 1e-5 * Vec3(u(rng), u(rng), u(rng));
+      if (trial % 5 == 2 && k == 3) f[1] = f[0] + 1e-4 * Vec3(u(rng), u(rng), u(rng));
+      if (trial % 5 == 3 && k == 11) f[2] = x + (f[0] - x) * 1e-6;
+      // Positive, as a star's tets are, but for one inverted in some stars.
+      const bool positive = (f[1] - f[0]).cross(f[2] - f[0]).dot(x - f[0]) > 0;
+      if (positive == (trial % 5 == 4 && k == 9)) std::swap(f[0], f[1]);
+      const auto q = mean_ratio_and_shape(f[0], f[1], f[2], x);
+      const auto before = plain;
+      plain = {std::min(plain.first, q.first), std::min(plain.second, q.second)};
+      lowered_late += k > 3 && plain != before;
+      fold_mean_ratio_and_shape(folded, f[0], f[1], f[2], x);
+      ASSERT_EQ(folded.first, plain.first) << "trial " << trial << " tet " << k;
+      ASSERT_EQ(folded.second, plain.second) << "trial " << trial << " tet " << k;
+    }
+  }
+  EXPECT_GT(lowered_late, 1000);  // the bounds were put to the test
 }

@@ -145,6 +145,44 @@ TEST(Measures, MinDihedralIsTheRangesMinimum) {
   EXPECT_EQ(tet_min_dihedral(p0, p0, p1, p2), 0);
 }
 
+// The optimizer's cheap bounds never claim more than the measures return,
+// on random tets, slivers, needles, caps near the threshold and inverted
+// ones; and they do settle most tets clearly above the threshold (else they
+// would save nothing).
+TEST(Measures, CheapBoundsAreOneSided) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
+  int clear = 0, settled = 0;
+  for (int trial = 0; trial < 40000; ++trial) {
+    std::array<Vec3, 4> v;
+    for (auto& x : v) x = Vec3(u(rng), u(rng), u(rng));
+    if (trial % 4 == 1) v[3] = (v[0] + v[1] + v[2]) / 3 + 1e-4 * Vec3(u(rng), u(rng), u(rng));
+    if (trial % 4 == 2) v[1] = v[0] + 1e-3 * Vec3(u(rng), u(rng), u(rng));
+    const double eta = tet_mean_ratio(v[0], v[1], v[2], v[3]);
+    const double angle = tet_min_dihedral(v[0], v[1], v[2], v[3]);
+    // Thresholds at, just under and just over the value, and random ones.
+    for (const double f : {1.0, 1 - 1e-12, 1 + 1e-12, 1 - 1e-6, unit(rng), 0.5}) {
+      const double r = eta * f, deg = angle * f;
+      if (tet_mean_ratio_at_least(v[0], v[1], v[2], v[3], r)) {
+        EXPECT_GE(eta, r) << "trial " << trial;
+      }
+      if (tet_min_dihedral_at_least(v[0], v[1], v[2], v[3], deg)) {
+        EXPECT_GE(angle, deg) << "trial " << trial;
+      }
+    }
+    if (eta > 0.05 && angle > 1) {
+      ++clear;
+      settled += tet_mean_ratio_at_least(v[0], v[1], v[2], v[3], 0.5 * eta) &&
+                 tet_min_dihedral_at_least(v[0], v[1], v[2], v[3], 0.5 * angle);
+    }
+  }
+  EXPECT_GT(clear, 1000);
+  EXPECT_EQ(settled, clear);  // half the value is always within the bounds' slack
+  const Vec3 p0(0, 0, 0), p1(1, 0, 0), p2(0, 1, 0), p3(0, 0, 1);
+  EXPECT_FALSE(tet_mean_ratio_at_least(p0, p2, p1, p3, -1));  // inverted: never settled
+  EXPECT_FALSE(tet_min_dihedral_at_least(p0, p0, p1, p2, 0));  // degenerate face
+}
+
 // The mean ratio's cube root is a fast one: against a long double
 // reference over a wide range of tet sizes and shapes.
 TEST(Measures, MeanRatioIsAccurateAtEveryScale) {

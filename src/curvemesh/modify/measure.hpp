@@ -15,4 +15,9 @@ double tet_quality(const mesh::TetMesh& m, const std::array<VertId, 4>& v);
 /// Smallest tet_quality over the given tets of the mesh.
 double min_quality(const mesh::TetMesh& m, std::span<const TetId> tets);
 
+/// min_quality when it is above `floor`; otherwise some value <= floor, found
+/// at the first tet that shows it: for candidates that are dropped unless
+/// they beat the floor.
+double min_quality_above(const mesh::TetMesh& m, std::span<const TetId> tets, double floor);
+
 }  // namespace cm::modify

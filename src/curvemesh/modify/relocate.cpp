@@ -35,7 +35,7 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cav, VertId v) {
   r.target = old;
   for (double w : {1.0, 0.5, 0.25}) {
     m.coords[v] = old + w * (centroid - old);
-    const double q = min_quality(m, ball);
+    const double q = min_quality_above(m, ball, r.after);
     if (q > r.after) {
       r.after = q;
       r.target = m.coords[v];
@@ -172,7 +172,7 @@ Relocation plan_relocation(MeshEditor& ed, Cavity& cav, const BoundaryIndex& sur
     for (double w : {1.0, 0.5, 0.25}) {
       const geom::Projection p = model->closest_point(entity, old + w * d, hint);
       m.coords[v] = p.point;
-      const double q = min_quality(m, ball);
+      const double q = min_quality_above(m, ball, r.before + 1e-6);
       if (q > r.before + 1e-6) candidates.push_back({p.point, p.param, q});
     }
   }

@@ -21,6 +21,23 @@ std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, con
   return {mr, std::min(mr, quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral)};
 }
 
+void fold_mean_ratio_and_shape(std::pair<double, double>& worst, const Vec3& a, const Vec3& b, const Vec3& c,
+                               const Vec3& d) {
+  if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) {
+    worst = {std::min(worst.first, -1.0), std::min(worst.second, -1.0)};
+    return;
+  }
+  // The tet lowers neither minimum when its mean ratio is at least both
+  // (its shape is at most its mean ratio) and its angle at least the shape's.
+  const double r = std::max(worst.first, worst.second);
+  if ((r <= 0 || quality::tet_mean_ratio_at_least(a, b, c, d, r)) &&
+      quality::tet_min_dihedral_at_least(a, b, c, d, worst.second * kRegularDihedral))
+    return;
+  const double mr = std::max(quality::tet_mean_ratio(a, b, c, d), 0.0);
+  worst.first = std::min(worst.first, mr);
+  worst.second = std::min(worst.second, std::min(mr, quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral));
+}
+
 TetShape tet_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const double angle = quality::tet_min_dihedral(a, b, c, d);
   if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) return {-1, -1, angle};

@@ -56,6 +56,13 @@ double mean_ratio_floor(double mr_before, double shape_before);
 /// above a floor while raising the second.
 std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
+/// worst = the elementwise minimum of worst and mean_ratio_and_shape(a, b,
+/// c, d), the same bits, but without computing either measure where a cheap
+/// bound shows the tet cannot lower it: most tets of a star or ball are far
+/// from its worst.
+void fold_mean_ratio_and_shape(std::pair<double, double>& worst, const Vec3& a, const Vec3& b, const Vec3& c,
+                               const Vec3& d);
+
 /// mean_ratio_and_shape with the tet's least dihedral angle (degrees,
 /// quality::tet_min_dihedral, whatever the orientation), which the shape
 /// is computed from: one evaluation where a judge needs all three.

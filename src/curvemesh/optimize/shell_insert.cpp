@@ -1,6 +1,7 @@
 #include "curvemesh/optimize/shell_insert.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "curvemesh/core/error.hpp"
@@ -14,17 +15,17 @@ namespace cm::optimize {
 namespace {
 
 // Worst mean ratio and worst angle-aware quality of the star of x over the
-// cavity boundary. A boundary face lists its vertices with the normal out of
-// the cavity, so the new tet has x behind it: (f1, f0, f2, x) is the
-// positive order.
+// cavity boundary; {-1, -1} as soon as a tet is invalid or the worst
+// angle-aware quality is at most `unless_above` (a smoothing step that does
+// not beat the point it started from). A boundary face lists its vertices
+// with the normal out of the cavity, so the new tet has x behind it:
+// (f1, f0, f2, x) is the positive order.
 std::pair<double, double> star_quality(const mesh::TetMesh& m, std::span<const modify::CavityFace> faces,
-                                       const Vec3& x) {
+                                       const Vec3& x, double unless_above = -INFINITY) {
   std::pair<double, double> q{1, 1};
   for (const auto& f : faces) {
-    const Vec3 &a = m.coords[f.verts[1]], &b = m.coords[f.verts[0]], &c = m.coords[f.verts[2]];
-    q.second = std::min(q.second, angle_aware_quality(a, b, c, x));
-    if (q.second <= 0) return {-1, -1};
-    q.first = std::min(q.first, modify::tet_quality_at(a, b, c, x));
+    fold_mean_ratio_and_shape(q, m.coords[f.verts[1]], m.coords[f.verts[0]], m.coords[f.verts[2]], x);
+    if (q.second <= 0 || q.second <= unless_above) return {-1, -1};
   }
   return q;
 }
@@ -32,9 +33,8 @@ std::pair<double, double> star_quality(const mesh::TetMesh& m, std::span<const m
 std::pair<double, double> worst_shape(const mesh::TetMesh& m, std::span<const TetId> tets) {
   std::pair<double, double> q{1, 1};
   for (TetId t : tets) {
-    q.first = std::min(q.first, modify::tet_quality_at(m.coords[m.tet2verts[t][0]], m.coords[m.tet2verts[t][1]],
-                                                       m.coords[m.tet2verts[t][2]], m.coords[m.tet2verts[t][3]]));
-    q.second = std::min(q.second, angle_aware_measure(m, m.tet2verts[t], nullptr));
+    const auto& v = m.tet2verts[t];
+    fold_mean_ratio_and_shape(q, m.coords[v[0]], m.coords[v[1]], m.coords[v[2]], m.coords[v[3]]);
   }
   return q;
 }
@@ -78,7 +78,7 @@ void place_point(const mesh::TetMesh& m, std::span<const modify::CavityFace> fac
     auto q = star_quality(m, faces, x);
     for (int it = 0; it < 4; ++it) {
       const Vec3 y = star_centroid(m, faces, x);
-      const auto qy = star_quality(m, faces, y);
+      const auto qy = star_quality(m, faces, y, q.second);
       if (!(qy.second > q.second)) break;
       x = y;
       q = qy;

@@ -1,6 +1,7 @@
 #include "curvemesh/optimize/vertex_search.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <span>
 #include <vector>
 
@@ -32,7 +33,11 @@ bool better(const Poll& p, const Poll& q, double margin) {
 // step h, and moves to the first poll that improves (then on along it, the
 // step doubling, while that pays); a round without improvement halves h.
 // Stops after max_polls polls or when h falls under h0 / 64.
-// poll_at(offset) -> Poll; guided(point, directions&) appends unit vectors.
+// poll_at(offset, below) -> Poll; guided(point, directions&) appends unit
+// vectors. A poll whose worst tet already scores under `below` cannot be
+// better than the current best, so poll_at may stop there and return a
+// failed poll (score -1): most polls fail, and most fail at the tet that
+// was worst before.
 template <class PollAt, class Guided>
 Poll compass_search(const Poll& first, std::span<const Vec3> frame, double h0, int max_polls, PollAt&& poll_at,
                     Guided&& guided) {
@@ -52,7 +57,7 @@ Poll compass_search(const Poll& first, std::span<const Vec3> frame, double h0, i
     for (const Vec3& d : directions) {
       if (polls >= max_polls) break;
       ++polls;
-      const Poll p = poll_at(offset + h * d);
+      const Poll p = poll_at(offset + h * d, best.score - 1e-12);
       if (!better(p, best, 1e-9)) continue;
       best = p;
       offset += h * d;
@@ -60,7 +65,7 @@ Poll compass_search(const Poll& first, std::span<const Vec3> frame, double h0, i
       // Keep going while it pays: a sliver may need a long way.
       while (polls < max_polls) {
         ++polls;
-        const Poll q = poll_at(offset + 2 * h * d);
+        const Poll q = poll_at(offset + 2 * h * d, best.score - 1e-12);
         if (!better(q, best, 1e-9)) break;
         best = q;
         h *= 2;
@@ -106,24 +111,37 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
   // now), so the search never leaves what the driver accepts.
   const double goal = angle_goal / kRegularDihedral;
   double floor = -1;
-  auto rank_at = [&](Poll& p) {
+  // The tet that scored worst at the last rank goes first: a failing poll
+  // usually fails there, and is cut short (compass_search's `below`).
+  std::size_t lead = 0;
+  auto rank_at = [&](Poll& p, double below) {
     m.coords[v] = p.point;
     double shape = 1, mr = 1;
-    for (std::size_t i = 0; i < ball.size(); ++i) {
+    bool cut = false;
+    const std::size_t led = lead;
+    for (std::size_t k = 0; k < ball.size(); ++k) {
+      const std::size_t i = k == 0 ? led : k == led ? 0 : k;
       const auto& tv = m.tet2verts[ball[i]];
+      const double shape_before = shape;
       if (needle[i]) {
         const TetShape q = tet_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
         shape = std::min(shape, needle_shape(q));
       } else {
-        const auto q = mean_ratio_and_shape(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
-        mr = std::min(mr, q.first);
-        shape = std::min(shape, q.second);
+        std::pair<double, double> worst{mr, shape};
+        fold_mean_ratio_and_shape(worst, m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]]);
+        mr = worst.first;
+        shape = worst.second;
       }
+      if (shape < shape_before) lead = i;
       if (shape <= 0 || mr < floor) break;
+      if (shape < below) {
+        cut = true;
+        break;
+      }
     }
     m.coords[v] = start;
     if (floor < 0) floor = mean_ratio_floor(mr, shape);  // the first call: at the start
-    const bool ok = shape > 0 && mr >= floor;
+    const bool ok = !cut && shape > 0 && mr >= floor;
     p.score = ok ? std::min(shape, goal) : -1;
     p.tie = ok ? mr : -1;
   };
@@ -151,7 +169,7 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
     for (int k = 0; k < dim; ++k) r += d.dot(frame[static_cast<std::size_t>(k)]) * frame[static_cast<std::size_t>(k)];
     return r;
   };
-  auto poll_at = [&](const Vec3& offset) {
+  auto poll_at = [&](const Vec3& offset, double below) {
     Poll p;
     if (dim == 3) {
       p.point = start + offset;
@@ -165,7 +183,7 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
       p.param = pr.param;
     }
     if (keep_out && keep_out->contains(p.point)) return p;
-    rank_at(p);
+    rank_at(p, below);
     return p;
   };
 
@@ -186,7 +204,7 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
   Poll first;
   first.point = start;
   first.param = param0;
-  rank_at(first);
+  rank_at(first, -INFINITY);
   auto lift_and_pull = [&](const Vec3& at, std::vector<Vec3>& directions) {
     // The worst tet's vertex lifted off its opposite face (the move that
     // opens a sliver), then the pull toward the centroid.
@@ -226,17 +244,30 @@ Vec3 search_star_point(const mesh::TetMesh& m, std::span<const modify::CavityFac
     return angle_aware_quality(m.coords[f.verts[1]], m.coords[f.verts[0]], m.coords[f.verts[2]], x);
   };
   const double goal = angle_goal / kRegularDihedral;
-  auto poll_at = [&](const Vec3& offset) {
+  std::size_t lead = 0;  // as in plan_searched_relocation
+  auto poll_at = [&](const Vec3& offset, double below) {
     Poll p;
     p.point = start + offset;
     double shape = 1, mr = 1;
-    for (const auto& f : faces) {
-      const auto q = mean_ratio_and_shape(m.coords[f.verts[1]], m.coords[f.verts[0]], m.coords[f.verts[2]], p.point);
-      mr = std::min(mr, q.first);
-      shape = std::min(shape, q.second);
+    bool cut = false;
+    const std::size_t led = lead;
+    for (std::size_t k = 0; k < faces.size(); ++k) {
+      const std::size_t i = k == 0 ? led : k == led ? 0 : k;
+      const auto& f = faces[i];
+      std::pair<double, double> worst{mr, shape};
+      fold_mean_ratio_and_shape(worst, m.coords[f.verts[1]], m.coords[f.verts[0]], m.coords[f.verts[2]], p.point);
+      mr = worst.first;
+      if (worst.second < shape) {
+        shape = worst.second;
+        lead = i;
+      }
       if (shape <= 0 || mr < mean_ratio_floor) break;
+      if (shape < below) {
+        cut = true;
+        break;
+      }
     }
-    const bool ok = shape > 0 && mr >= mean_ratio_floor;
+    const bool ok = !cut && shape > 0 && mr >= mean_ratio_floor;
     p.score = ok ? std::min(shape, goal) : -1;
     p.tie = ok ? mr : -1;
     return p;
@@ -257,7 +288,7 @@ Vec3 search_star_point(const mesh::TetMesh& m, std::span<const modify::CavityFac
     if (n.squaredNorm() > 0) directions.push_back(n.normalized());
   };
   const std::array<Vec3, 3> frame{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
-  return compass_search(poll_at(Vec3::Zero()), frame, h0, max_polls, poll_at, lift).point;
+  return compass_search(poll_at(Vec3::Zero(), -INFINITY), frame, h0, max_polls, poll_at, lift).point;
 }
 
 }  // namespace cm::optimize

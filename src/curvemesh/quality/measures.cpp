@@ -198,6 +198,41 @@ double tet_min_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3&
   return 180.0 - std::atan2(nk.cross(nl).norm(), nk.dot(nl)) * kRadToDeg;
 }
 
+bool tet_mean_ratio_at_least(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double r) {
+  const double volume = tet_signed_volume(a, b, c, d), sum_sq = sum_squared_edges(a, b, c, d);
+  if (!(volume > 0) || !(sum_sq > 0) || !std::isfinite(sum_sq)) return false;
+  if (r <= 0) return true;
+  // eta >= r  <=>  12^3 * 9 V^2 >= r^3 S^3. The margin (1e-9 relative,
+  // against a few ulps of error on either side and in the cube root) keeps
+  // the test one-sided.
+  const double rs = r * sum_sq;
+  return 15552.0 * volume * volume > rs * rs * rs * (1 + 1e-9);
+}
+
+bool tet_min_dihedral_at_least(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double degrees) {
+  // The interior angle at an edge is acos(-cs), cs the cosine between the
+  // outward normals of its faces, and acos(-cs) = 2 asin(sqrt((1 + cs) / 2))
+  // >= sqrt(2 (1 + cs)). So every angle is at least T (radians) when every
+  // cs >= T^2 / 2 - 1 = c0 (< 0 for T < 81 degrees), i.e. when
+  // n_k.n_l >= 0 or (n_k.n_l)^2 <= c0^2 |n_k|^2 |n_l|^2. T is raised by a
+  // margin for the round-off of this test and of tet_min_dihedral.
+  const double t = (std::max(degrees, 0.0) * (1 + 1e-9) + 1e-9) / kRadToDeg;
+  const double c0 = 0.5 * t * t - 1;
+  if (!(c0 < 0)) return false;
+  const double c0_sq = c0 * c0 * (1 - 1e-12);
+  const auto n = face_normals({&a, &b, &c, &d});
+  std::array<double, 4> sq;
+  for (int f = 0; f < 4; ++f) {
+    sq[f] = n[f].squaredNorm();
+    if (!(sq[f] > 0) || !std::isfinite(sq[f])) return false;
+  }
+  for (const auto& o : kOtherFaces) {
+    const double dot = n[o[0]].dot(n[o[1]]);
+    if (dot < 0 && !(dot * dot <= c0_sq * sq[o[0]] * sq[o[1]])) return false;
+  }
+  return true;
+}
+
 double metric_length(const Vec3& e, const Mat3& metric) {
   return std::sqrt(std::max(0.0, e.dot(metric * e)));
 }

@@ -51,6 +51,14 @@ AngleRange tet_dihedral_range(const Vec3& a, const Vec3& b, const Vec3& c, const
 /// for millions of times.
 double tet_min_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
+/// Cheap one-sided tests for searches that only need a tet's measure when it
+/// is below a running minimum: true only when tet_mean_ratio(a, b, c, d) >= r
+/// (no cube root), resp. tet_min_dihedral(a, b, c, d) >= degrees (no square
+/// root, division or atan2), holds for the values those functions return,
+/// round-off included. False means "maybe not": compute the measure.
+bool tet_mean_ratio_at_least(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double r);
+bool tet_min_dihedral_at_least(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double degrees);
+
 /// Length sqrt(e^T M e) of the vector e in the metric M (3x3 symmetric positive
 /// definite; not checked).
 double metric_length(const Vec3& e, const Mat3& metric);
