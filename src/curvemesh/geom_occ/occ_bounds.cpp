@@ -20,10 +20,10 @@ struct CoordinateJet {
   double huu, huv, hvv;
 };
 
-CoordinateJet coordinate_jet(const Geom_Surface& s, const Vec2& uv, int axis, double sign) {
+CoordinateJet coordinate_jet(const SurfaceEvaluator& s, const Vec2& uv, int axis, double sign) {
   gp_Pnt p;
   gp_Vec du, dv, duu, dvv, duv;
-  s.D2(uv.x(), uv.y(), p, du, dv, duu, dvv, duv);
+  s.d2(uv.x(), uv.y(), p, du, dv, duu, dvv, duv);
   const int k = axis + 1;  // gp coordinates are 1-based
   return {sign * p.Coord(k), sign * Vec2(du.Coord(k), dv.Coord(k)), sign * duu.Coord(k),
           sign * duv.Coord(k), sign * dvv.Coord(k)};
@@ -32,7 +32,7 @@ CoordinateJet coordinate_jet(const Geom_Surface& s, const Vec2& uv, int axis, do
 // Local maximum of sign * S(u,v)[axis] from `uv`, kept in [lo, hi]: Newton
 // where the Hessian is negative definite, else a gradient step; a step is
 // taken only if it increases the coordinate.
-Vec2 maximize_coordinate(const Geom_Surface& s, Vec2 uv, int axis, double sign, const Vec2& lo,
+Vec2 maximize_coordinate(const SurfaceEvaluator& s, Vec2 uv, int axis, double sign, const Vec2& lo,
                          const Vec2& hi, const Vec2& scale) {
   CoordinateJet jet = coordinate_jet(s, uv, axis, sign);
   for (int iter = 0; iter < kMaxSteps; ++iter) {
@@ -78,10 +78,10 @@ void add_interior_extremes(const FaceData& face, geom::BoundingBox& box) {
       for (std::size_t k = 1; k < n; ++k)
         if (sign * face.sample_points[k][axis] > sign * face.sample_points[best][axis]) best = k;
       const Vec2 uv =
-          maximize_coordinate(*face.surface, face.sample_params[best], axis, sign, lo, hi, scale);
+          maximize_coordinate(face.eval, face.sample_params[best], axis, sign, lo, hi, scale);
       // A maximum outside the trimmed face is bounded by the boundary edges.
       if (!face_contains(face, uv)) continue;
-      const gp_Pnt p = face.surface->Value(uv.x(), uv.y());
+      const gp_Pnt p = face.eval.value(uv.x(), uv.y());
       box.add(Vec3(p.X(), p.Y(), p.Z()));
     }
   }

@@ -189,6 +189,7 @@ void OccModel::build_edges(const TopoDS_Shape& shape, const ShapeMaps& maps) {
                                         entity_name(1, i)));
     }
     while (auto trimmed = Handle(Geom_TrimmedCurve)::DownCast(d.curve)) d.curve = trimmed->BasisCurve();
+    d.eval = CurveEvaluator(d.curve);
     d.type = curve_type(BRepAdaptor_Curve(d.edge).GetType());
     if (d.curve->IsPeriodic() && d.vertices[0] == d.vertices[1]) {
       const double period = d.curve->Period();
@@ -209,7 +210,7 @@ void OccModel::build_edges(const TopoDS_Shape& shape, const ShapeMaps& maps) {
     for (int k = 0; k < n; ++k) {
       const double u = d.first + (d.last - d.first) * k / (n - 1);
       d.sample_params[k] = u;
-      d.sample_points[k] = to_vec(d.curve->Value(u));
+      d.sample_points[k] = to_vec(d.eval.value(u));
     }
   }
 }
@@ -252,6 +253,7 @@ void OccModel::build_faces(const TopoDS_Shape& shape, const ShapeMaps& maps) {
     d.surface = BRep_Tool::Surface(d.face);
     while (auto trimmed = Handle(Geom_RectangularTrimmedSurface)::DownCast(d.surface))
       d.surface = trimmed->BasisSurface();
+    d.eval = SurfaceEvaluator(d.surface);
     d.type = surface_type(BRepAdaptor_Surface(d.face, false).GetType());
     d.tolerance = BRep_Tool::Tolerance(d.face);
 
@@ -483,7 +485,7 @@ void OccModel::build_face_samples(FaceData& d) {
       if (!inside[static_cast<std::size_t>(i * nv + j)]) continue;
       const Vec2 uv = param_at(i, j);
       d.sample_params.push_back(uv);
-      d.sample_points.push_back(to_vec(d.surface->Value(uv.x(), uv.y())));
+      d.sample_points.push_back(to_vec(d.eval.value(uv.x(), uv.y())));
     }
   d.grid_samples = d.sample_points.size();
   // Box: a face's extreme coordinates are on its boundary (the edges' exact
@@ -506,7 +508,7 @@ void OccModel::build_face_samples(FaceData& d) {
     for (int k = 0; k < kPerEdge; ++k) {
       const gp_Pnt2d p = use.curve->Value(e.first + (e.last - e.first) * (k + 0.5) / kPerEdge);
       d.sample_params.emplace_back(p.X(), p.Y());
-      d.sample_points.push_back(to_vec(d.surface->Value(p.X(), p.Y())));
+      d.sample_points.push_back(to_vec(d.eval.value(p.X(), p.Y())));
     }
   }
 }

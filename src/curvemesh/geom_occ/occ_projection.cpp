@@ -56,10 +56,10 @@ struct SurfacePoint {
   Vec3 p, du, dv, duu, duv, dvv;
 };
 
-SurfacePoint eval(const Geom_Surface& s, const Vec2& uv) {
+SurfacePoint eval(const SurfaceEvaluator& s, const Vec2& uv) {
   gp_Pnt p;
   gp_Vec du, dv, duu, dvv, duv;
-  s.D2(uv.x(), uv.y(), p, du, dv, duu, dvv, duv);
+  s.d2(uv.x(), uv.y(), p, du, dv, duu, dvv, duv);
   return {to_vec(p.XYZ()), to_vec(du.XYZ()), to_vec(dv.XYZ()),
           to_vec(duu.XYZ()), to_vec(duv.XYZ()), to_vec(dvv.XYZ())};
 }
@@ -109,7 +109,7 @@ Vec2 into_box(Vec2 uv, const SearchBox& b) {
 }
 
 // Newton on a face's surface, (u, v) kept in the search box.
-NewtonResult newton_on_surface(const Geom_Surface& s, const Vec3& x, Vec2 uv, const SearchBox& box,
+NewtonResult newton_on_surface(const SurfaceEvaluator& s, const Vec3& x, Vec2 uv, const SearchBox& box,
                                double eps_len) {
   const Vec2& lo = box.lo;
   const Vec2& hi = box.hi;
@@ -260,16 +260,16 @@ double newton_1d(const Jet& jet, const Vec3& x, double t, double lo, double hi, 
   return t;
 }
 
-CurveJet curve_jet(const Geom_Curve& curve, double t) {
+CurveJet curve_jet(const CurveEvaluator& curve, double t) {
   gp_Pnt p;
   gp_Vec d1, d2;
-  curve.D2(t, p, d1, d2);
+  curve.d2(t, p, d1, d2);
   return {to_vec(p.XYZ()), to_vec(d1.XYZ()), to_vec(d2.XYZ())};
 }
 
 // The image S(pc(t)) of a p-curve: the face's boundary as the surface sees
 // it, which may stand off the 3D edge by up to the edge's tolerance.
-CurveJet pcurve_jet(const Geom_Surface& s, const Geom2d_Curve& pc, double t) {
+CurveJet pcurve_jet(const SurfaceEvaluator& s, const Geom2d_Curve& pc, double t) {
   gp_Pnt2d uv;
   gp_Vec2d c1, c2;
   pc.D2(t, uv, c1, c2);
@@ -312,7 +312,7 @@ geom::Projection OccModel::project_on_edge(const EdgeData& e, const Vec3& x,
   }
   const double period = e.range.periodic_u ? e.range.period_u : 0;
   const double eps_len = 1e-13 * scale_;
-  const auto jet = [&](double t) { return curve_jet(*e.curve, t); };
+  const auto jet = [&](double t) { return curve_jet(e.eval, t); };
   const auto newton = [&](double t, bool& converged) {
     return newton_1d(jet, x, t, e.first, e.last, period, eps_len, converged);
   };
@@ -367,7 +367,7 @@ geom::Projection OccModel::project_on_face(const FaceData& f, const Vec3& x,
   };
   const auto inside = [&](const Vec2& uv) { return face_contains(f, uv); };
   if (hint) {
-    const NewtonResult r = newton_on_surface(*f.surface, x, *hint, box, eps_len);
+    const NewtonResult r = newton_on_surface(f.eval, x, *hint, box, eps_len);
     if (r.converged && inside(r.uv)) return finish_newton(r);
   }
   // Two starts: the nearest interior seed and the nearest boundary seed. A
@@ -390,7 +390,7 @@ geom::Projection OccModel::project_on_face(const FaceData& f, const Vec3& x,
   std::optional<geom::Projection> found;
   std::optional<Vec2> left_face;  // an answer outside the trimmed face
   const auto descend_from = [&](std::size_t seed) {
-    const NewtonResult r = newton_on_surface(*f.surface, x, f.sample_params[seed], box, eps_len);
+    const NewtonResult r = newton_on_surface(f.eval, x, f.sample_params[seed], box, eps_len);
     if (!inside(r.uv)) {
       left_face = r.uv;
       return;
@@ -446,7 +446,7 @@ geom::Projection OccModel::project_on_face_boundary(const FaceData& f, const Vec
   }
   if (best_edge == 0) {
     // Only degenerate edges (cannot happen on a valid face): keep the Newton answer.
-    const Vec3 p = eval(*f.surface, near_uv).p;
+    const Vec3 p = eval(f.eval, near_uv).p;
     return {p, near_uv, (p - x).norm()};
   }
   // Refine along each p-curve of that edge (a seam has two: both sides are
@@ -457,10 +457,10 @@ geom::Projection OccModel::project_on_face_boundary(const FaceData& f, const Vec
   for (const PCurveUse& use : f.pcurves) {
     if (use.edge != best_edge || use.curve.IsNull()) continue;
     bool converged = false;
-    const double t = newton_1d([&](double s) { return pcurve_jet(*f.surface, *use.curve, s); }, x,
+    const double t = newton_1d([&](double s) { return pcurve_jet(f.eval, *use.curve, s); }, x,
                                best.param.x(), edge.first, edge.last, 0, 1e-13 * scale_, converged);
     const Vec2 uv = pcurve_point(use, t);
-    const Vec3 p = eval(*f.surface, uv).p;
+    const Vec3 p = eval(f.eval, uv).p;
     const double d = (p - x).norm();
     const double gap = (uv - near_uv).squaredNorm();
     if (d < result.distance || (d == result.distance && gap < uv_gap)) {
@@ -470,9 +470,9 @@ geom::Projection OccModel::project_on_face_boundary(const FaceData& f, const Vec
   }
   if (std::isfinite(result.distance)) return result;
   // No p-curve stored: locate the edge point on the surface.
-  const NewtonResult r = newton_on_surface(*f.surface, best.point, near_uv, search_box(f),
+  const NewtonResult r = newton_on_surface(f.eval, best.point, near_uv, search_box(f),
                                            1e-13 * scale_);
-  const Vec3 p = eval(*f.surface, r.uv).p;
+  const Vec3 p = eval(f.eval, r.uv).p;
   return {p, r.uv, (p - x).norm()};
 }
 

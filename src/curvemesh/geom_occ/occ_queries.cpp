@@ -24,7 +24,7 @@ geom::SurfaceDerivatives eval_surface(const FaceData& f, int tag, const Vec2& uv
   gp_Pnt p;
   gp_Vec du, dv, duu, dvv, duv;
   try {
-    f.surface->D2(uv.x(), uv.y(), p, du, dv, duu, dvv, duv);
+    f.eval.d2(uv.x(), uv.y(), p, du, dv, duu, dvv, duv);
   } catch (const Standard_Failure& e) {
     throw GeometryError(fmt::format("face {}: cannot evaluate at ({}, {}): {}", tag, uv.x(),
                                     uv.y(), e.GetMessageString()));
@@ -77,7 +77,7 @@ geom::CurveDerivatives OccModel::edge_derivatives(int edge, double u) const {
   gp_Pnt p;
   gp_Vec d1, d2;
   try {
-    e.curve->D2(u, p, d1, d2);
+    e.eval.d2(u, p, d1, d2);
   } catch (const Standard_Failure& ex) {
     throw GeometryError(
         fmt::format("edge {}: cannot evaluate at {}: {}", edge, u, ex.GetMessageString()));

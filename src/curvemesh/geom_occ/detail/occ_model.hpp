@@ -8,8 +8,9 @@
 // in GeomAdaptor_* (mutable, per adaptor, NOT thread-safe) and no longer in
 // Geom_BSplineSurface/Curve, whose D0..D3 are const and read-only; offset,
 // revolution and extrusion surfaces built from Geom handles evaluate through
-// GeomEvaluator_* holding Geom handles, equally read-only. No query constructs
-// or touches a shared adaptor. The one shared OCC object with hidden mutable
+// GeomEvaluator_* holding Geom handles, equally read-only. No query touches
+// a shared adaptor: B-spline surfaces and 3D curves are evaluated through
+// adaptors of the calling thread (detail/occ_evaluator.hpp). The one shared OCC object with hidden mutable
 // state is the trimmed-face classifier, which is locked per face (see
 // FaceData::classifier); the solid classifiers of classify_point are worse
 // (every Perform mutates them) and are lent out one per caller from a
@@ -44,6 +45,7 @@
 #include <TopTools_IndexedMapOfShape.hxx>
 
 #include "curvemesh/geom/model.hpp"
+#include "curvemesh/geom_occ/detail/occ_evaluator.hpp"
 #include "curvemesh/geom_occ/detail/triangle_classifier.hpp"
 #include "curvemesh/geom_occ/detail/trim_classifier.hpp"
 
@@ -79,6 +81,7 @@ struct VertexData {
 struct EdgeData {
   TopoDS_Edge edge;  // FORWARD
   Handle(Geom_Curve) curve;  // global coordinates, trimming wrappers removed; null if degenerate
+  CurveEvaluator eval;       // of curve: what queries evaluate it through
   double first = 0, last = 0;
   bool degenerate = false;
   geom::ShapeType type = geom::ShapeType::kOtherCurve;
@@ -103,6 +106,7 @@ struct PCurveUse {
 struct FaceData {
   TopoDS_Face face;  // oriented as in its first region
   Handle(Geom_Surface) surface;  // global coordinates, trimming wrappers removed
+  SurfaceEvaluator eval;         // of surface: what queries evaluate it through
   bool flip_normal = false;  // du x dv points into the first region
   geom::ShapeType type = geom::ShapeType::kOtherSurface;
   geom::ParamRange range;  // UV bounds of the trimmed face
