@@ -16,14 +16,19 @@ using Basis = std::array<std::array<double, kMaxOrder>, 3>;
 
 // The degree + 1 basis functions that are nonzero on span i, and their
 // first `wanted` (<= 2) derivatives, at t: n[k][j] is the k-th derivative of
-// N_{i - degree + j}. The triangular recurrence of the basis (Cox-de Boor)
-// keeps the knot differences below the diagonal, from which the
-// derivatives follow; t outside the span gives the span's polynomials
-// extended. Every knot difference used spans the span itself, so none is
-// zero for a span of positive length.
+// N_{i - degree + j}. The triangular recurrence (Cox-de Boor) gives the
+// nonzero functions of every degree up to `degree`; a derivative of degree
+// p is p times the difference of two degree p - 1 functions (or
+// derivatives) over their knot spans. Each knot difference is inverted
+// once. t outside the span gives the span's polynomials extended. Every
+// knot difference used spans the span itself, so none is zero for a span
+// of positive length.
 void basis_derivatives(const std::vector<double>& knots, int i, double t, int degree, int wanted, Basis& n) {
   const int p = degree;
-  std::array<std::array<double, kMaxOrder>, kMaxOrder> ndu;
+  // ndu[r][j] (r <= j): N_{i - j + r, j}(t), the degree j functions;
+  // inv[j][r] (r < j): one over u_{i + r + 1} - u_{i + r + 1 - j}, the knot
+  // span of N_{i - j + r + 1, j - 1} and of N_{i - j + r, j}'s right half.
+  std::array<std::array<double, kMaxOrder>, kMaxOrder> ndu, inv;
   std::array<double, kMaxOrder> left, right;
   ndu[0][0] = 1;
   for (int j = 1; j <= p; ++j) {
@@ -31,47 +36,34 @@ void basis_derivatives(const std::vector<double>& knots, int i, double t, int de
     right[j] = knots[i + j] - t;
     double saved = 0;
     for (int r = 0; r < j; ++r) {
-      ndu[j][r] = right[r + 1] + left[j - r];
-      const double q = ndu[r][j - 1] / ndu[j][r];
+      inv[j][r] = 1 / (right[r + 1] + left[j - r]);
+      const double q = ndu[r][j - 1] * inv[j][r];
       ndu[r][j] = saved + right[r + 1] * q;
       saved = left[j - r] * q;
     }
     ndu[j][j] = saved;
   }
-  for (int j = 0; j <= p; ++j) n[0][j] = ndu[j][p];
-  const int orders = std::min(wanted, p);
-  std::array<std::array<double, kMaxOrder>, 2> a;
-  for (int r = 0; r <= p; ++r) {
-    int s1 = 0, s2 = 1;
-    a[0][0] = 1;
-    for (int k = 1; k <= orders; ++k) {
-      double d = 0;
-      const int rk = r - k, pk = p - k;
-      if (r >= k) {
-        a[s2][0] = a[s1][0] / ndu[pk + 1][rk];
-        d = a[s2][0] * ndu[rk][pk];
-      }
-      const int j1 = rk >= -1 ? 1 : -rk;
-      const int j2 = r - 1 <= pk ? k - 1 : p - r;
-      for (int j = j1; j <= j2; ++j) {
-        a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][rk + j];
-        d += a[s2][j] * ndu[rk + j][pk];
-      }
-      if (r <= pk) {
-        a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
-        d += a[s2][k] * ndu[r][pk];
-      }
-      n[k][r] = d;
-      std::swap(s1, s2);
-    }
+  for (int r = 0; r <= p; ++r) n[0][r] = ndu[r][p];
+  if (wanted == 0) return;
+  if (p < 1) {
+    for (int k = 1; k <= wanted; ++k) n[k].fill(0);
+    return;
   }
-  double factor = p;
-  for (int k = 1; k <= orders; ++k) {
-    for (int j = 0; j <= p; ++j) n[k][j] *= factor;
-    factor *= p - k;
+  // First derivatives: N'_{r} = p (a[r - 1] - a[r]), a[s] = N_{s, p-1} / span.
+  std::array<double, kMaxOrder + 1> a;
+  for (int s = 0; s < p; ++s) a[s] = ndu[s][p - 1] * inv[p][s];
+  for (int r = 0; r <= p; ++r) n[1][r] = p * ((r > 0 ? a[r - 1] : 0) - (r < p ? a[r] : 0));
+  if (wanted == 1) return;
+  if (p < 2) {
+    n[2].fill(0);
+    return;
   }
-  for (int k = orders + 1; k <= wanted; ++k)
-    for (int j = 0; j <= p; ++j) n[k][j] = 0;
+  // Second: the same step on the degree p - 1 derivatives d.
+  std::array<double, kMaxOrder> b, d;
+  for (int s = 0; s < p - 1; ++s) b[s] = ndu[s][p - 2] * inv[p - 1][s];
+  for (int s = 0; s < p; ++s) d[s] = (p - 1) * ((s > 0 ? b[s - 1] : 0) - (s < p - 1 ? b[s] : 0));
+  for (int s = 0; s < p; ++s) a[s] = d[s] * inv[p][s];
+  for (int r = 0; r <= p; ++r) n[2][r] = p * ((r > 0 ? a[r - 1] : 0) - (r < p ? a[r] : 0));
 }
 
 Vec3 xyz(const std::array<double, 4>& h) { return {h[0], h[1], h[2]}; }
@@ -143,27 +135,57 @@ Vec3 SplineSurface::d0(double pu, double pv) const {
   return rational ? Vec3(xyz(s) / s[3]) : xyz(s);
 }
 
-void SplineSurface::d2(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv, Vec3& duu, Vec3& dvv, Vec3& duv) const {
-  const int du_deg = u.degree, dv_deg = v.degree;
+namespace {
+
+// s[k][l]: the k-th u- and l-th v-derivative (k + l <= Orders) of the
+// first C homogeneous coordinates, row by row (a row's poles are
+// contiguous).
+template <int C, int Orders>
+void surface_sums(const SplineSurface& f, int iu, int iv, const Basis& nu, const Basis& nv,
+                  std::array<std::array<std::array<double, 4>, 3>, 3>& s) {
+  const int pu = f.u.degree, pv = f.v.degree;
+  for (int a = 0; a <= pu; ++a) {
+    const std::array<double, 4>* row = &f.poles[static_cast<std::size_t>((iu - pu + a) * f.poles_v + (iv - pv))];
+    std::array<std::array<double, C>, Orders + 1> r{};
+    for (int b = 0; b <= pv; ++b)
+      for (int l = 0; l <= Orders; ++l)
+        for (int c = 0; c < C; ++c) r[l][c] += nv[l][b] * row[b][c];
+    for (int k = 0; k <= Orders; ++k)
+      for (int l = 0; l + k <= Orders; ++l)
+        for (int c = 0; c < C; ++c) s[k][l][c] += nu[k][a] * r[l][c];
+  }
+}
+
+}  // namespace
+
+void SplineSurface::d1(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv) const {
   const int iu = u.locate(pu), iv = v.locate(pv);
   Basis nu, nv;
-  basis_derivatives(u.knots, iu, pu, du_deg, 2, nu);
-  basis_derivatives(v.knots, iv, pv, dv_deg, 2, nv);
-  // s[k][l]: the homogeneous k-th u- and l-th v-derivative (k + l <= 2),
-  // through the rows' u-sums t[k] for each column b.
+  basis_derivatives(u.knots, iu, pu, u.degree, 1, nu);
+  basis_derivatives(v.knots, iv, pv, v.degree, 1, nv);
   std::array<std::array<std::array<double, 4>, 3>, 3> s{};
-  for (int b = 0; b <= dv_deg; ++b) {
-    std::array<std::array<double, 4>, 3> t{};
-    for (int a = 0; a <= du_deg; ++a) {
-      const auto& pole = poles[static_cast<std::size_t>((iu - du_deg + a) * poles_v + (iv - dv_deg + b))];
-      for (int k = 0; k < 3; ++k)
-        for (int c = 0; c < 4; ++c) t[k][c] += nu[k][a] * pole[c];
-    }
-    for (int k = 0; k < 3; ++k)
-      for (int l = 0; l + k < 3; ++l)
-        for (int c = 0; c < 4; ++c) s[k][l][c] += nv[l][b] * t[k][c];
-  }
   if (!rational) {
+    surface_sums<3, 1>(*this, iu, iv, nu, nv, s);
+    p = xyz(s[0][0]);
+    du = xyz(s[1][0]);
+    dv = xyz(s[0][1]);
+    return;
+  }
+  surface_sums<4, 1>(*this, iu, iv, nu, nv, s);
+  const double w = s[0][0][3];
+  p = xyz(s[0][0]) / w;
+  du = (xyz(s[1][0]) - s[1][0][3] * p) / w;
+  dv = (xyz(s[0][1]) - s[0][1][3] * p) / w;
+}
+
+void SplineSurface::d2(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv, Vec3& duu, Vec3& dvv, Vec3& duv) const {
+  const int iu = u.locate(pu), iv = v.locate(pv);
+  Basis nu, nv;
+  basis_derivatives(u.knots, iu, pu, u.degree, 2, nu);
+  basis_derivatives(v.knots, iv, pv, v.degree, 2, nv);
+  std::array<std::array<std::array<double, 4>, 3>, 3> s{};
+  if (!rational) {
+    surface_sums<3, 2>(*this, iu, iv, nu, nv, s);
     p = xyz(s[0][0]);
     du = xyz(s[1][0]);
     dv = xyz(s[0][1]);
@@ -172,6 +194,8 @@ void SplineSurface::d2(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv, Vec3& 
     duv = xyz(s[1][1]);
     return;
   }
+  surface_sums<4, 2>(*this, iu, iv, nu, nv, s);
+  // The quotient rule on (A, w) = (sum N w P, sum N w).
   const double w = s[0][0][3];
   p = xyz(s[0][0]) / w;
   du = (xyz(s[1][0]) - s[1][0][3] * p) / w;
