@@ -137,46 +137,25 @@ Vec3 SplineSurface::d0(double pu, double pv) const {
 
 namespace {
 
-// s[k][l]: the k-th u- and l-th v-derivative (k + l <= Orders) of the
-// first C homogeneous coordinates, row by row (a row's poles are
-// contiguous).
-template <int C, int Orders>
+// s[k][l]: the k-th u- and l-th v-derivative (k + l <= 2) of the first C
+// homogeneous coordinates, row by row (a row's poles are contiguous).
+template <int C>
 void surface_sums(const SplineSurface& f, int iu, int iv, const Basis& nu, const Basis& nv,
                   std::array<std::array<std::array<double, 4>, 3>, 3>& s) {
   const int pu = f.u.degree, pv = f.v.degree;
   for (int a = 0; a <= pu; ++a) {
     const std::array<double, 4>* row = &f.poles[static_cast<std::size_t>((iu - pu + a) * f.poles_v + (iv - pv))];
-    std::array<std::array<double, C>, Orders + 1> r{};
+    std::array<std::array<double, C>, 3> r{};
     for (int b = 0; b <= pv; ++b)
-      for (int l = 0; l <= Orders; ++l)
+      for (int l = 0; l < 3; ++l)
         for (int c = 0; c < C; ++c) r[l][c] += nv[l][b] * row[b][c];
-    for (int k = 0; k <= Orders; ++k)
-      for (int l = 0; l + k <= Orders; ++l)
+    for (int k = 0; k < 3; ++k)
+      for (int l = 0; l + k < 3; ++l)
         for (int c = 0; c < C; ++c) s[k][l][c] += nu[k][a] * r[l][c];
   }
 }
 
 }  // namespace
-
-void SplineSurface::d1(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv) const {
-  const int iu = u.locate(pu), iv = v.locate(pv);
-  Basis nu, nv;
-  basis_derivatives(u.knots, iu, pu, u.degree, 1, nu);
-  basis_derivatives(v.knots, iv, pv, v.degree, 1, nv);
-  std::array<std::array<std::array<double, 4>, 3>, 3> s{};
-  if (!rational) {
-    surface_sums<3, 1>(*this, iu, iv, nu, nv, s);
-    p = xyz(s[0][0]);
-    du = xyz(s[1][0]);
-    dv = xyz(s[0][1]);
-    return;
-  }
-  surface_sums<4, 1>(*this, iu, iv, nu, nv, s);
-  const double w = s[0][0][3];
-  p = xyz(s[0][0]) / w;
-  du = (xyz(s[1][0]) - s[1][0][3] * p) / w;
-  dv = (xyz(s[0][1]) - s[0][1][3] * p) / w;
-}
 
 void SplineSurface::d2(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv, Vec3& duu, Vec3& dvv, Vec3& duv) const {
   const int iu = u.locate(pu), iv = v.locate(pv);
@@ -185,7 +164,7 @@ void SplineSurface::d2(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv, Vec3& 
   basis_derivatives(v.knots, iv, pv, v.degree, 2, nv);
   std::array<std::array<std::array<double, 4>, 3>, 3> s{};
   if (!rational) {
-    surface_sums<3, 2>(*this, iu, iv, nu, nv, s);
+    surface_sums<3>(*this, iu, iv, nu, nv, s);
     p = xyz(s[0][0]);
     du = xyz(s[1][0]);
     dv = xyz(s[0][1]);
@@ -194,7 +173,7 @@ void SplineSurface::d2(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv, Vec3& 
     duv = xyz(s[1][1]);
     return;
   }
-  surface_sums<4, 2>(*this, iu, iv, nu, nv, s);
+  surface_sums<4>(*this, iu, iv, nu, nv, s);
   // The quotient rule on (A, w) = (sum N w P, sum N w).
   const double w = s[0][0][3];
   p = xyz(s[0][0]) / w;

@@ -52,7 +52,6 @@ struct SplineSurface {
   bool rational = false;
   /// Point, first and second derivatives at (u, v).
   void d2(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv, Vec3& duu, Vec3& dvv, Vec3& duv) const;
-  void d1(double pu, double pv, Vec3& p, Vec3& du, Vec3& dv) const;
   Vec3 d0(double pu, double pv) const;
 };
 
