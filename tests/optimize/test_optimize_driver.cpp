@@ -331,6 +331,11 @@ TEST(MeasuredSwap, FoldingIsThePlainMinimumBitForBit) {
       plain = {std::min(plain.first, q.first), std::min(plain.second, q.second)};
       lowered_late += k > 3 && plain != before;
       fold_mean_ratio_and_shape(folded, f[0], f[1], f[2], x);
+      // The worst-tet search's bound: never above the quality itself.
+      for (const double at : {q.second, std::nextafter(q.second, 2.0), 0.5 * q.second, plain.second})
+        if (angle_aware_quality_at_least(f[0], f[1], f[2], x, at)) {
+          ASSERT_GE(q.second, at) << "trial " << trial << " tet " << k;
+        }
       ASSERT_EQ(folded.first, plain.first) << "trial " << trial << " tet " << k;
       ASSERT_EQ(folded.second, plain.second) << "trial " << trial << " tet " << k;
     }

@@ -21,6 +21,13 @@ std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, con
   return {mr, std::min(mr, quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral)};
 }
 
+bool angle_aware_quality_at_least(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double q) {
+  // Its mean ratio (clamped at 0) and scaled angle both at least q.
+  return predicates::orient3d(a.data(), b.data(), c.data(), d.data()) > 0 &&
+         (q <= 0 || quality::tet_mean_ratio_at_least(a, b, c, d, q)) &&
+         quality::tet_min_dihedral_at_least(a, b, c, d, q * kRegularDihedral);
+}
+
 void fold_mean_ratio_and_shape(std::pair<double, double>& worst, const Vec3& a, const Vec3& b, const Vec3& c,
                                const Vec3& d) {
   if (predicates::orient3d(a.data(), b.data(), c.data(), d.data()) <= 0) {

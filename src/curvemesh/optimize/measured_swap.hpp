@@ -31,6 +31,10 @@ inline constexpr double kRegularDihedral = 70.528779365509308;
 /// exact orient3d. A sliver can keep a fair mean ratio with a tiny angle;
 /// ranking by both makes the angle count where it is the problem.
 double angle_aware_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+/// Whether angle_aware_quality(a, b, c, d) >= q for certain, by cheap
+/// bounds (quality::tet_mean_ratio_at_least, tet_min_dihedral_at_least);
+/// false means "maybe not": compute it. For the search of a worst tet.
+bool angle_aware_quality_at_least(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double q);
 /// angle_aware_quality of mesh vertices, as a TetMeasure (context unused).
 double angle_aware_measure(const mesh::TetMesh& m, const std::array<VertId, 4>& v, const void* context);
 

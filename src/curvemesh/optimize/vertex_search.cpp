@@ -212,7 +212,12 @@ modify::Relocation plan_searched_relocation(modify::MeshEditor& ed, modify::Cavi
     TetId worst = ball.front();
     double worst_q = 2;
     for (TetId t : ball) {
-      const double q = angle_aware_measure(m, m.tet2verts[t], nullptr);
+      const auto& tv = m.tet2verts[t];
+      // Cannot be the first worst: most of the ball, by a cheap bound.
+      if (worst_q <= 1 &&
+          angle_aware_quality_at_least(m.coords[tv[0]], m.coords[tv[1]], m.coords[tv[2]], m.coords[tv[3]], worst_q))
+        continue;
+      const double q = angle_aware_measure(m, tv, nullptr);
       if (q < worst_q) worst_q = q, worst = t;
     }
     m.coords[v] = start;
@@ -280,8 +285,12 @@ Vec3 search_star_point(const mesh::TetMesh& m, std::span<const modify::CavityFac
   auto lift = [&](const Vec3& at, std::vector<Vec3>& directions) {
     const modify::CavityFace* worst = nullptr;
     double worst_q = 2;
-    for (const auto& f : faces)
+    for (const auto& f : faces) {
+      if (worst_q <= 1 && angle_aware_quality_at_least(m.coords[f.verts[1]], m.coords[f.verts[0]],
+                                                       m.coords[f.verts[2]], at, worst_q))
+        continue;  // as in lift_and_pull
       if (const double q = tet_score(f, at); q < worst_q) worst_q = q, worst = &f;
+    }
     if (!worst) return;
     const Vec3 &a = m.coords[worst->verts[0]], &b = m.coords[worst->verts[1]], &c = m.coords[worst->verts[2]];
     const Vec3 n = -(b - a).cross(c - a);
