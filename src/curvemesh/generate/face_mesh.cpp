@@ -7,6 +7,7 @@
 #include <queue>
 
 #include <fmt/format.h>
+#include <tbb/parallel_invoke.h>
 
 #include "curvemesh/core/error.hpp"
 #include "curvemesh/core/predicates.hpp"
@@ -88,6 +89,9 @@ class FaceMesher {
   // Valence flips: how many rounds (each followed by smoothing), and how
   // poor a pair of triangles they may leave for the smoothing to even out.
   static constexpr int kValencePasses = 2;
+  // Faces with at least this many vertices optimize their two variants in
+  // parallel (below, the copy and the task cost more than they save).
+  static constexpr std::size_t kSideBySideVertices = 400;
   static constexpr double kValenceFloor = 0.6;
 
   bool alive(std::size_t t) const { return t_.is_live(static_cast<int>(t)); }
@@ -583,21 +587,35 @@ class FaceMesher {
   // is not undone. Both are run from the same start; the regular one is kept
   // only when its worst triangle is no worse and its sum is larger, so the
   // face's worst triangle is never lowered by the extra step.
+  // The two runs are independent, so a large face runs them side by side
+  // on a copy of the mesher: a model of one big face (a torus) otherwise
+  // leaves a core idle. Each run is the same computation either way.
   void optimize() {
-    const auto passes = [&] {
-      for (int pass = 0; pass < o_.optimize_passes; ++pass)
-        if (flip_pass() + smooth_pass() == 0) break;
+    const auto passes = [](FaceMesher& f) {
+      for (int pass = 0; pass < f.o_.optimize_passes; ++pass)
+        if (f.flip_pass() + f.smooth_pass() == 0) break;
     };
+    const auto regular_passes = [&](FaceMesher& f) {
+      for (int pass = 0; pass < kValencePasses; ++pass) {
+        if (f.valence_pass() == 0) break;
+        f.smooth_pass();
+      }
+      passes(f);
+    };
+    if (uv_.size() >= kSideBySideVertices) {
+      FaceMesher regular(*this);
+      tbb::parallel_invoke([&] { passes(*this); }, [&] { regular_passes(regular); });
+      const auto [plain_worst, plain_sum] = quality_summary();
+      const auto [regular_worst, regular_sum] = regular.quality_summary();
+      if (regular_worst >= plain_worst && regular_sum > plain_sum) restore(regular.save());
+      return;
+    }
     State start = save();
-    passes();
+    passes(*this);
     const auto [plain_worst, plain_sum] = quality_summary();
     State plain = save();
     restore(std::move(start));
-    for (int pass = 0; pass < kValencePasses; ++pass) {
-      if (valence_pass() == 0) break;
-      smooth_pass();
-    }
-    passes();
+    regular_passes(*this);
     const auto [regular_worst, regular_sum] = quality_summary();
     if (!(regular_worst >= plain_worst && regular_sum > plain_sum)) restore(std::move(plain));
   }
