@@ -3,8 +3,8 @@
 // surfaces and 3D curves, the innermost call of projections and meshing.
 //
 // B-spline surfaces and curves are evaluated by detail/bspline.hpp from a
-// plain copy of their poles and knots, two to four times faster than
-// OCC's evaluation (bspline.hpp says why), with no state; other kinds of
+// plain copy of their poles and knots, faster than OCC's evaluation
+// (bspline.hpp says why and by how much), with no state; other kinds of
 // geometry through the Geom handle, which is read-only (detail/
 // occ_model.hpp, thread safety). Values agree with OCC's to round-off, not
 // bit for bit.
