@@ -89,8 +89,7 @@ class FaceMesher {
   // Valence flips: how many rounds (each followed by smoothing), and how
   // poor a pair of triangles they may leave for the smoothing to even out.
   static constexpr int kValencePasses = 2;
-  // Faces with at least this many vertices optimize their two variants in
-  // parallel (below, the copy and the task cost more than they save).
+  // Below, the copy and the task of optimize's side-by-side runs cost more.
   static constexpr std::size_t kSideBySideVertices = 400;
   static constexpr double kValenceFloor = 0.6;
 
@@ -549,23 +548,15 @@ class FaceMesher {
     });
   }
 
-  // The vertex state the optimization changes (the size h_ it does not).
-  struct State {
-    Triangulation2d t;
-    std::vector<Vec2> uv;
-    std::vector<Vec3> xyz, normal;
-    std::vector<std::array<Vec3, 2>> tangent;
-    int flips = 0, moves = 0;
-  };
-  State save() const { return {t_, uv_, xyz_, normal_, tangent_, out_.flips, out_.smoothing_moves}; }
-  void restore(State&& s) {
-    t_ = std::move(s.t);
-    uv_ = std::move(s.uv);
-    xyz_ = std::move(s.xyz);
-    normal_ = std::move(s.normal);
-    tangent_ = std::move(s.tangent);
-    out_.flips = s.flips;
-    out_.smoothing_moves = s.moves;
+  // The vertex state the optimization changes (not h_), from a copy.
+  void take_state(FaceMesher&& other) {
+    t_ = std::move(other.t_);
+    uv_ = std::move(other.uv_);
+    xyz_ = std::move(other.xyz_);
+    normal_ = std::move(other.normal_);
+    tangent_ = std::move(other.tangent_);
+    out_.flips = other.out_.flips;
+    out_.smoothing_moves = other.out_.smoothing_moves;
   }
   // Worst and sum of the triangle qualities.
   std::pair<double, double> quality_summary() const {
@@ -584,12 +575,10 @@ class FaceMesher {
   // vertex valences stay as the refinement left them; flips towards valence
   // 6 first, then the same passes, give more regular and on average better
   // triangles, but may leave a worse worst one where a flip to a poorer pair
-  // is not undone. Both are run from the same start; the regular one is kept
-  // only when its worst triangle is no worse and its sum is larger, so the
-  // face's worst triangle is never lowered by the extra step.
-  // The two runs are independent, so a large face runs them side by side
-  // on a copy of the mesher: a model of one big face (a torus) otherwise
-  // leaves a core idle. Each run is the same computation either way.
+  // is not undone. Both run from the same start, the regular one on a copy
+  // (side by side for a large face: one big face, a torus, would leave a
+  // core idle), and it is kept only when its worst triangle is no worse and
+  // its sum is larger: the extra step never lowers the face's worst.
   void optimize() {
     const auto passes = [](FaceMesher& f) {
       for (int pass = 0; pass < f.o_.optimize_passes; ++pass)
@@ -602,22 +591,16 @@ class FaceMesher {
       }
       passes(f);
     };
+    FaceMesher regular(*this);
     if (uv_.size() >= kSideBySideVertices) {
-      FaceMesher regular(*this);
       tbb::parallel_invoke([&] { passes(*this); }, [&] { regular_passes(regular); });
-      const auto [plain_worst, plain_sum] = quality_summary();
-      const auto [regular_worst, regular_sum] = regular.quality_summary();
-      if (regular_worst >= plain_worst && regular_sum > plain_sum) restore(regular.save());
-      return;
+    } else {
+      passes(*this);
+      regular_passes(regular);
     }
-    State start = save();
-    passes(*this);
     const auto [plain_worst, plain_sum] = quality_summary();
-    State plain = save();
-    restore(std::move(start));
-    regular_passes(*this);
-    const auto [regular_worst, regular_sum] = quality_summary();
-    if (!(regular_worst >= plain_worst && regular_sum > plain_sum)) restore(std::move(plain));
+    const auto [regular_worst, regular_sum] = regular.quality_summary();
+    if (regular_worst >= plain_worst && regular_sum > plain_sum) take_state(std::move(regular));
   }
 
   // Flips an edge when that brings the valences of its four vertices (the

@@ -21,11 +21,19 @@ std::pair<double, double> mean_ratio_and_shape(const Vec3& a, const Vec3& b, con
   return {mr, std::min(mr, quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral)};
 }
 
+namespace {
+
+// For a strictly positive tet: whether, by the cheap bounds, its mean ratio
+// (clamped at 0) is at least mr and its scaled angle at least shape.
+bool bounded_below(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double mr, double shape) {
+  return (mr <= 0 || quality::tet_mean_ratio_at_least(a, b, c, d, mr)) &&
+         quality::tet_min_dihedral_at_least(a, b, c, d, shape * kRegularDihedral);
+}
+
+}  // namespace
+
 bool angle_aware_quality_at_least(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double q) {
-  // Its mean ratio (clamped at 0) and scaled angle both at least q.
-  return predicates::orient3d(a.data(), b.data(), c.data(), d.data()) > 0 &&
-         (q <= 0 || quality::tet_mean_ratio_at_least(a, b, c, d, q)) &&
-         quality::tet_min_dihedral_at_least(a, b, c, d, q * kRegularDihedral);
+  return predicates::orient3d(a.data(), b.data(), c.data(), d.data()) > 0 && bounded_below(a, b, c, d, q, q);
 }
 
 void fold_mean_ratio_and_shape(std::pair<double, double>& worst, const Vec3& a, const Vec3& b, const Vec3& c,
@@ -36,10 +44,7 @@ void fold_mean_ratio_and_shape(std::pair<double, double>& worst, const Vec3& a, 
   }
   // The tet lowers neither minimum when its mean ratio is at least both
   // (its shape is at most its mean ratio) and its angle at least the shape's.
-  const double r = std::max(worst.first, worst.second);
-  if ((r <= 0 || quality::tet_mean_ratio_at_least(a, b, c, d, r)) &&
-      quality::tet_min_dihedral_at_least(a, b, c, d, worst.second * kRegularDihedral))
-    return;
+  if (bounded_below(a, b, c, d, std::max(worst.first, worst.second), worst.second)) return;
   const double mr = std::max(quality::tet_mean_ratio(a, b, c, d), 0.0);
   worst.first = std::min(worst.first, mr);
   worst.second = std::min(worst.second, std::min(mr, quality::tet_min_dihedral(a, b, c, d) / kRegularDihedral));
